@@ -1,0 +1,283 @@
+"""Gyrocompass on a torsion suspension with elastic rotor bearings (Bashirov, 1983).
+
+Source: shared/seeds/003_d8c34eaefd40a65d.txt; equation numbers are the paper's.
+This file says what the system IS: coordinates (1.1), frames (1.2)-(1.6), positions and
+velocities (1.7)-(1.8), energies (1.9), Pi, (1.10), the paper's printed operator blocks (2.4)
+and its approximate formulas (3.2)-(3.28). Everything that follows from it (equations,
+equilibrium, operator, polynomials, emission) is done by the generic machinery.
+"""
+from __future__ import annotations
+
+import sympy as sp
+
+from derive import mechanics as mech
+from derive.model import Parameter
+
+NAME = "torsion_gyrocompass"
+TITLE = "Gyrocompass on a torsion suspension with elastic rotor bearings"
+SOURCE = "shared/seeds/003_d8c34eaefd40a65d.txt (Bashirov 1983)"
+
+# ----------------------------------------------------------------------------- parameters
+# The paper's example (end of section 3), as reconstructed in shared/PAPERS.md: the printed
+# frequencies omega_0, omega_p, omega_y and Omega give the stiffnesses and H.
+_m, _A = 0.4, 1.2e-4
+PARAMETERS = [
+    Parameter("m", "kg", _m, "rotor mass"),
+    Parameter("M", "kg", 0.6, "casing (sensing element without rotor) mass"),
+    Parameter("l", "m", 0.15, "torsion bar length"),
+    Parameter("l1", "m", 0.15, "distance O' to casing mass centre O1"),
+    Parameter("l2", "m", 0.25, "distance O' to rotor centre O2"),
+    Parameter("A", "kg m^2", _A, "rotor equatorial moment of inertia"),
+    Parameter("C", "kg m^2", 1.8e-4, "rotor polar moment of inertia"),
+    Parameter("I1", "kg m^2", 1.05e-2, "casing moment of inertia about x1"),
+    Parameter("I2", "kg m^2", 1.07e-2, "casing moment of inertia about x2"),
+    Parameter("I3", "kg m^2", 3e-4, "casing moment of inertia about x3"),
+    Parameter("K0", "N/m", _m * 450.0**2, "axial bearing stiffness (omega_0 = 450 1/s)"),
+    Parameter("Kp", "N/m", _m * 780.0**2, "radial bearing stiffness (omega_p = 780 1/s)"),
+    Parameter("Kgamma", "N m/rad", _A * 560.0**2, "angular bearing stiffness (omega_y = 560 1/s)"),
+    Parameter("H", "kg m^2/s", _A * 3769.3, "rotor angular momentum H = A Omega", kind="nonnegative"),
+    Parameter("u", "rad/s", 7.29e-5, "Earth rotation rate", kind="nonnegative"),
+    Parameter("phi", "deg", 60.0, "latitude", kind="real", bounds=(-90.0, 90.0)),
+    Parameter("g", "m/s^2", 9.81, "gravity along the plumb line", kind="nonnegative"),
+]
+P = {p.name: p.symbol for p in PARAMETERS}
+m, M, l, l1, l2, A, C, I1, I2, I3, K0, Kp, Kgamma, H, u, phi, g = (P[p.name] for p in PARAMETERS)
+phi_rad = phi * sp.pi / 180
+u2, u3 = u * sp.cos(phi_rad), u * sp.sin(phi_rad)  # (1.3)
+
+# Symbols that the model uses before they are eliminated (shown symbolically to leave it).
+R1, j, nu = sp.symbols("R1 j nu")
+h = sp.Symbol("h")  # bearing length in (1.10); enters the forcing only
+
+# ----------------------------------------------------------------------------- coordinates
+# (1.1): sigma = {x1, x2, x3, gamma1, gamma2, gamma3, alpha, beta, gamma, lambda, mu}
+COORDINATES = ["x1", "x2", "x3", "gamma1", "gamma2", "gamma3", "alpha", "beta", "gamma", "lam", "mu"]
+q = sp.symbols(COORDINATES)
+qd = sp.symbols([c + "_d" for c in COORDINATES])
+qdd = sp.symbols([c + "_dd" for c in COORDINATES])
+x1, x2, x3, gamma1, gamma2, gamma3, alpha, beta, gamma, lam, mu = q
+x1d, x2d, x3d, gamma1d, gamma2d, gamma3d, alphad, betad, gammad, lamd, mud = qd
+
+CYCLIC = "gamma3"
+# (2.4): q = {x1, x3, gamma, mu, x2, gamma1, gamma2, alpha, beta, lambda}; J = diag(J', J'')
+REDUCED = ["x1", "x3", "gamma", "mu", "x2", "gamma1", "gamma2", "alpha", "beta", "lam"]
+BLOCKS = [["x1", "x3", "gamma", "mu"], ["x2", "gamma1", "gamma2", "alpha", "beta", "lam"]]
+# Reflection in the meridian plane (xi1 -> -xi1) with time reversal maps u and H to
+# themselves; these coordinates change sign under it, so a symmetric equilibrium has them
+# zero. The derivation checks that their equilibrium equations vanish identically there.
+ODD = ["x1", "gamma", "mu", "gamma1", "alpha"]
+
+# Imperfection functions f_s(gamma3) of (1.10)-(1.11): symbolic functions, zero for free
+# vibration. For emission they are replaced by input values F_s and their derivatives dF_s.
+f1, f2, f3 = (sp.Function(f"f{s}") for s in (1, 2, 3))
+
+
+def frames():
+    """Rotation S (1.2), Earth rate (1.3), casing rate p (1.5), rotor rate r (1.6)."""
+    S = mech.rotation([("z", alpha), ("x", beta), ("y", gamma)])  # (1.2)
+    u_vec = sp.Matrix([0, u2, u3])  # (1.3)
+    p = mech.angular_velocity([("z", alpha), ("x", beta), ("y", gamma)], [alphad, betad, gammad], base=u_vec)  # (1.5)
+    # (1.6): rotor axes that do not take part in the spin gamma3 (same sequence as alpha,
+    # beta, gamma), with the spin rate along the rotor's 2-axis.
+    r = mech.angular_velocity([("z", gamma1), ("x", gamma2)], [gamma1d, gamma2d], base=p)
+    r = r + gamma3d * mech.unit("y")
+    return S, u_vec, p, r
+
+
+def positions(S):
+    """(1.7): torsion end xi, casing centre xi^(1), rotor centre xi^(2) in O xi1 xi2 xi3."""
+    xi = sp.Matrix([-l * sp.sin(mu), l * sp.sin(lam) * sp.cos(mu), -l * sp.cos(lam) * sp.cos(mu)])
+    e3 = S[:, 2]
+    xi1 = xi - l1 * e3
+    xi2 = xi + S * sp.Matrix([x1, x2, x3]) - l2 * e3
+    return xi1, xi2
+
+
+def kinetic_energy(V0):
+    """(1.9) with the velocities (1.8): V^(h) = V0 + u x xi^(h) + d xi^(h)/dt."""
+    S, u_vec, p, r = frames()
+    xi1, xi2 = positions(S)
+    V1 = V0 + mech.cross(u_vec, xi1) + mech.time_derivative(xi1, q, qd)
+    V2 = V0 + mech.cross(u_vec, xi2) + mech.time_derivative(xi2, q, qd)
+    return (mech.kinetic_energy(M, V1, (I1, I2, I3), p)
+            + mech.kinetic_energy(m, V2, (A, C, A), r))
+
+
+def bearing_force_function():
+    """(1.10): U with imperfection functions f_s(gamma3)."""
+    F1, F2, F3 = f1(gamma3), f2(gamma3), f3(gamma3)
+    return (x1 * F1 + x2 * F2 + x3 * F3 + h * gamma1 * F1 - h * gamma2 * F3
+            - sp.Rational(1, 2) * (Kp * x1**2 + K0 * x2**2 + Kp * x3**2
+                                   + Kgamma * gamma1**2 + Kgamma * gamma2**2))
+
+
+def lagrangian_with_plumb_line():
+    """L = T - Pi + U as the paper states it: origin velocity V0 (1.4) and gravity j along
+    the plumb line deflected by nu from xi3 (Pi between (1.9) and (1.10))."""
+    S, *_ = frames()
+    V0 = sp.Matrix([u * R1 * sp.cos(phi_rad), 0, 0])  # (1.4)
+    xi1, xi2 = positions(S)
+    eta3 = lambda xi_: xi_[2] * sp.cos(nu) - xi_[1] * sp.sin(nu)  # noqa: E731
+    Pi = m * j * eta3(xi2) + M * j * eta3(xi1)
+    return kinetic_energy(V0) - Pi + bearing_force_function()
+
+
+def lagrangian():
+    """L = T - Pi + U with V0 = 0 and gravity g along -xi3 (the form the derivation uses).
+
+    `plumb_line_reduction` shows that it differs from `lagrangian_with_plumb_line` only by a
+    total time derivative and a constant once j cos nu - u2^2 R1 = g, j sin nu - u2 u3 R1 = 0.
+    """
+    S, *_ = frames()
+    xi1, xi2 = positions(S)
+    Pi_g = g * (m * xi2[2] + M * xi1[2])
+    return kinetic_energy(sp.zeros(3, 1)) - Pi_g + bearing_force_function()
+
+
+def plumb_line_reduction():
+    """The V0 terms of T and the plumb-line Pi combine into gravity g along xi3 (below (2.4)).
+
+    Uses cos(nu) = (g + u2^2 R1)/j and sin(nu) = u2 u3 R1/j, which are the paper's two
+    relations solved for cos and sin. Returns the Lagrange expressions of the difference of
+    the two Lagrangians: all identically zero, so R1, j and nu leave the model.
+    """
+    L_paper = lagrangian_with_plumb_line()
+    L_g = lagrangian()
+    rel = {sp.cos(nu): (g + u2**2 * R1) / j, sp.sin(nu): u2 * u3 * R1 / j}
+    dL = (L_paper - L_g).subs(rel)
+    return mech.null_lagrangian_residual(dL, q, qd, qdd)
+
+
+# ----------------------------------------------------------------------------- section 2
+m_c = m + M
+l_c = (m * l2 + M * l1) / m_c
+G = m_c * l_c * g  # (2.4) abbreviations
+I2p = I2 + m * l2**2 + M * l1**2
+a = (A + I3) / A
+b0 = (m * l2**2 + M * l1**2 + A + I1) / A
+Omega = H / A
+omega_y2, omega_p2, omega_02 = Kgamma / A, Kp / m, K0 / m
+
+
+def equilibrium_approx():
+    """(2.2): approximate stationary solution, valid for m_c l_c g >> H u, Omega >> g/l, u."""
+    beta0 = H * u3 / (G + H * u2)
+    return {
+        "beta": beta0,
+        "gamma2": H * u3 / Kgamma,
+        "x2": -m * g * beta0 / K0,
+        "x3": -m * g / Kp,
+        "lam": (l + l_c) * u2 * u3 / g,
+    }
+
+
+# The paper's approximations behind the printed operator (2.4), applied to the exact
+# expansion (text below (2.4) and in section 2):
+#  1. linearise at q = 0 instead of q0: products q0_i q'_j are second order, so the
+#     equilibrium offsets (all proportional to u3 or to g/K) leave the coefficients;
+#  2. terms with u3 are dropped (u3 q' terms are of the size of G beta0 q', g lambda0 q');
+#  3. terms of second order in the Earth rate (u^2, centrifugal) are dropped;
+#  4. in the terms linear in u, A u and I_i u are neglected against H: the moments of
+#     inertia A, I1, I2, I3 are set to zero in the coefficient of u (H, m u l are kept).
+_u2s, _u3s = sp.symbols("u2 u3")
+
+
+def paper_approximation(expr):
+    """Apply approximations 2-4 above to one entry of M, D or K taken at q = 0."""
+    e = sp.expand(expr.subs({u2: _u2s, u3: _u3s}))
+    e = e.subs(_u3s, 0)
+    e0 = e.subs(_u2s, 0)
+    e1 = sp.diff(e, _u2s).subs(_u2s, 0).subs({A: 0, I1: 0, I2: 0, I3: 0})
+    return sp.expand(e0 + e1 * u2)
+
+
+# Rows of the print are divided by these factors (translations by m, the rotor and casing
+# angles gamma1, gamma2, alpha, beta by A; gamma, mu, lambda as they are).
+PRINT_ROW_SCALE = {"x1": m, "x3": m, "gamma": 1, "mu": 1, "x2": m,
+                   "gamma1": A, "gamma2": A, "alpha": A, "beta": A, "lam": 1}
+
+
+def printed_operator(p):
+    """The blocks J', J'' exactly as printed in (2.4), rows as in PRINT_ROW_SCALE.
+
+    Returns (J', J'') as SymPy matrices in the operator p. The three entries that differ
+    from the derivation are listed in PRINT_CORRECTIONS and in docs/paper_operator.md.
+    """
+    J59 = l2 * p**2 + g
+    J34 = m_c * l_c * l * p**2
+    J44 = m_c * (l**2 * p**2 + l * g)
+    J66 = p**2 + omega_y2 + Omega * u2
+    J99 = b0 * p**2 + Omega * u2 + G / A
+    Jp = sp.Matrix([
+        [p**2 + omega_p2, 2 * u2 * p, -J59, -l * p**2],
+        [-2 * u2 * p, p**2 + omega_p2, 2 * l2 * u2 * p, 2 * l * u2 * p],
+        [-m * J59, -m * u2 * l2 * p, I2p * p**2 + G, J34],
+        [-m * l * p**2, -m * u2 * l * p, J34, J44],
+    ])
+    Jpp = sp.Matrix([
+        [p**2 + omega_02, 0, 0, 0, J59, l * p**2],
+        [0, J66, Omega * p, p**2 + Omega * u2, Omega * p, 0],
+        [0, -Omega * p, J66, -Omega * p, p**2 + Omega * u2, 0],
+        [0, p**2 + Omega * u2, Omega * p, a * p**2 + Omega * u2, Omega * p, 0],
+        [m * J59 / A, -Omega * p, p**2 + Omega * u2, -Omega * p, J99, J34],
+        [m * l * p**2, 0, 0, 0, J34, J44],
+    ])
+    return Jp, Jpp
+
+
+def print_corrections(p):
+    """Entries where the print and the derivation differ: (block, row, col) 1-based ->
+    (printed, derived, reason). The derived entry follows from the Lagrangian; the
+    gyroscopic matrix D of a Lagrangian system is skew-symmetric, which the print breaks."""
+    J34 = m_c * l_c * l * p**2
+    skew = ("gyroscopic (Coriolis) coupling must be skew-symmetric: J'[2,{c}] m = {v} "
+            "requires J'[{r},2] = -{v}; the print lost the factor 2")
+    return {
+        ("J'", 3, 2): (-m * u2 * l2 * p, -2 * m * u2 * l2 * p, skew.format(c=3, r=3, v="2 m l2 u2 p")),
+        ("J'", 4, 2): (-m * u2 * l * p, -2 * m * u2 * l * p, skew.format(c=4, r=4, v="2 m l u2 p")),
+        ("J''", 5, 6): (J34, J34 / A, "row beta is divided by A like its other entries (m J59/A, "
+                        "J99 = b0 p^2 + ...); the mass matrix is symmetric, so it is J34/A "
+                        "against J''[6,5] = J34"),
+    }
+
+
+# ----------------------------------------------------------------------------- section 3
+
+
+def section3_formulas():
+    """The paper's approximate natural frequencies (3.2)-(3.28): name -> expression, and
+    name -> the equation it comes from with the OCR reading taken."""
+    f, d = {}, {}
+    f["omega5"] = sp.sqrt(omega_p2)
+    d["omega5"] = "(3.7) omega5 = omega_p"
+    return f, d
+
+
+# ----------------------------------------------------------------------------- the model
+
+
+def build():
+    """The model as data for the generic pipeline."""
+    from derive.model import Model, Variant
+
+    given = [f1(gamma3), f2(gamma3), f3(gamma3)]
+    formulas, docs = section3_formulas()
+    return Model(
+        name=NAME, title=TITLE, source=SOURCE, module=__name__,
+        parameters=PARAMETERS, coordinates=COORDINATES, q=list(q), qd=list(qd), qdd=list(qdd),
+        lagrangian=lagrangian(),
+        given_functions=given,
+        given_values=list(sp.symbols("F1 F2 F3")),
+        given_derivatives=list(sp.symbols("dF1 dF2 dF3")),
+        cyclic={CYCLIC: H},
+        reduced=REDUCED,
+        symmetric_zero=ODD,
+        equilibrium_approx=equilibrium_approx(),
+        identities={"plumb line: V0 and Pi reduce to gravity g along xi3 (below (2.4))": plumb_line_reduction},
+        variants={"paper": Variant(
+            approximate=paper_approximation, row_scale=PRINT_ROW_SCALE,
+            printed=printed_operator, corrections=print_corrections,
+            doc="the paper's printed operator (2.4): linearised at q = 0, u3 dropped, u^2 "
+                "dropped, A u and I_i u neglected against H")},
+        formulas=formulas, formula_docs=docs,
+    )

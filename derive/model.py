@@ -90,6 +90,7 @@ class Model:
     given_functions: list = field(default_factory=list)
     given_values: list = field(default_factory=list)
     given_derivatives: list = field(default_factory=list)
+    given_constants: list = field(default_factory=list)  # symbols used only with them (e.g. h)
     cyclic: dict = field(default_factory=dict)  # coordinate -> momentum parameter symbol
     reduced: list[str] = field(default_factory=list)  # order of the operator's coordinates
     symmetric_zero: list[str] = field(default_factory=list)  # zero at the equilibrium

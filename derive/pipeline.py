@@ -172,3 +172,74 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
 
     deriv.timings = steps.timings
     return deriv
+
+
+def functions(d: Derivation) -> list[Function]:
+    """The functions to emit for a derived model, with their inputs and outputs."""
+    model = d.model
+    params = ("params", model.symbols)
+    qe = ("qe", d.even)
+    order = model.reduced or [c for c in model.coordinates if c not in model.cyclic]
+    even_names = [str(x) for x in d.even]
+    fns = [
+        Function("equilibrium_residual", [params, qe], [("r", d.equilibrium_residual)],
+                 "Generalised forces dR/dq at rest on the symmetric set (R: Routh function); "
+                 f"zero at a relative equilibrium. Rows: {', '.join(order)}."),
+    ]
+    if model.equilibrium_approx:
+        fns.append(Function("equilibrium_approx", [params],
+                            [("qe", sp.Matrix([model.equilibrium_approx[c] for c in even_names]))],
+                            f"Approximate equilibrium (2.2) of {', '.join(even_names)}."))
+    op = d.operator
+    fns.append(Function("operator", [params, qe], [("M", op.M), ("D", op.D), ("K", op.K)],
+                        "Exact linear operator about the equilibrium qe: M q'' + D q' + K q = 0 "
+                        f"over q = ({', '.join(order)}); M, K symmetric, D skew."))
+    fns.append(Function("operator_J", [params, qe, ("pval", [P_SYMBOL])], [("J", op.J(P_SYMBOL))],
+                        "J(p) = M p^2 + D p + K of the exact operator at a real p."))
+    for vname, v in d.variants.items():
+        fns.append(Function(f"{vname}_operator", [params],
+                            [("M", v.operator.M), ("D", v.operator.D), ("K", v.operator.K)],
+                            f"Operator of the '{vname}' variant ({model.variants[vname].doc}); "
+                            "rows not scaled."))
+        fns.append(Function(f"{vname}_charpoly", [params],
+                            [(f"block{i + 1}", sp.Matrix(c)) for i, c in enumerate(v.charpoly)],
+                            f"Characteristic polynomial of each diagonal block of the '{vname}' "
+                            "operator: coefficients of det J_block in z = p^2, lowest degree first."))
+    if model.formulas:
+        fns.append(Function("formulas", [params],
+                            [("values", sp.Matrix(list(model.formulas.values())))],
+                            "The paper's approximate formulas, in the order of metadata "
+                            "'formulas'."))
+    fns.append(Function("mass_matrix", [params, ("q", model.q)], [("Mq", d.mass_matrix)],
+                        "Mass matrix of the full nonlinear equations (1.13): Mq qdd = f."))
+    given = [("given", model.given_values), ("dgiven", model.given_derivatives),
+             ("constants", model.given_constants)] if model.given_values else []
+    fns.append(Function("forcing", [params, ("q", model.q), ("qd", model.qd)] + given,
+                        [("f", d.forcing)],
+                        "Right-hand side f(q, qd) of the full nonlinear equations (1.13), "
+                        "Mq qdd = f, with the given functions' values and derivatives as inputs."))
+    return fns
+
+
+def metadata(d: Derivation) -> dict:
+    """JSON-serialisable facts the runtime needs without SymPy."""
+    model = d.model
+    order = model.reduced or [c for c in model.coordinates if c not in model.cyclic]
+    return {
+        "model": model.name,
+        "title": model.title,
+        "paper": model.source,
+        "parameters": [
+            {"name": p.name, "unit": p.unit, "default": p.default, "description": p.description,
+             "kind": p.kind, "bounds": list(p.bounds)} for p in model.parameters],
+        "coordinates": model.coordinates,
+        "cyclic": {c: str(s) for c, s in model.cyclic.items()},
+        "reduced": order,
+        "equilibrium_coordinates": [str(x) for x in d.even],
+        "symmetric_zero": model.symmetric_zero,
+        "given": [str(s) for s in model.given_values + model.given_derivatives + model.given_constants],
+        "variants": {name: {"blocks": [[order[i] for i in b] for b in v.blocks]}
+                     for name, v in d.variants.items()},
+        "formulas": [{"name": k, "doc": model.formula_docs.get(k, "")} for k in model.formulas],
+        "route_agreement": d.route_agreement,
+    }

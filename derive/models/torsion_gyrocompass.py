@@ -269,6 +269,7 @@ def build():
         given_functions=given,
         given_values=list(sp.symbols("F1 F2 F3")),
         given_derivatives=list(sp.symbols("dF1 dF2 dF3")),
+        given_constants=[h],
         cyclic={CYCLIC: H},
         reduced=REDUCED,
         symmetric_zero=ODD,

@@ -1,0 +1,238 @@
+"""Emission: one symbolic result -> CasADi, NumPy and C code through jinja2 templates.
+
+For each `Function` of a model, the expressions of all its outputs go through one
+common-subexpression elimination; the same CSE is printed three ways:
+- `casadi_functions.py`: CasADi `Function` objects (SX graphs built at import);
+- `numpy_functions.py`: vectorised NumPy functions over a leading batch of parameter sets;
+- `<model>.h`, `<model>.c`: flat, allocation-free C99.
+Every file starts with a header naming the template it came from, saying it must not be
+edited, and carrying a hash of the inputs that made it (the sources of `derive/`, the
+templates and the pinned SymPy, SymEngine and CasADi versions). Bytes are deterministic:
+no timestamps, canonical CSE order, sorted JSON.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+from importlib import metadata as importlib_metadata
+from pathlib import Path
+
+import jinja2
+import sympy as sp
+from sympy.printing.c import C99CodePrinter
+from sympy.printing.numpy import NumPyPrinter
+from sympy.printing.pycode import PythonCodePrinter
+
+from derive.model import Function
+
+ROOT = Path(__file__).resolve().parent.parent
+TEMPLATES = ROOT / "templates"
+TOOL_VERSIONS = ("sympy", "symengine", "casadi")
+
+
+# --------------------------------------------------------------------------- printers
+
+
+def _float_literal(x) -> str:
+    return repr(float(x))
+
+
+class CPrinter(C99CodePrinter):
+    """C99 with small integer powers as products and constants as double literals."""
+
+    def _print_Pow(self, expr):
+        b, e = expr.base, expr.exp
+        if e.is_Integer and 2 <= abs(int(e)) <= 4:
+            prod = "*".join([self.parenthesize(b, 1000)] * abs(int(e)))
+            return prod if e > 0 else f"1.0/({prod})"
+        if e == sp.Rational(1, 2):
+            return f"sqrt({self._print(b)})"
+        if e == -sp.Rational(1, 2):
+            return f"1.0/sqrt({self._print(b)})"
+        if e == -1:
+            return f"1.0/{self.parenthesize(b, 1000)}"
+        return f"pow({self._print(b)}, {self._print(e)})"
+
+    def _print_Pi(self, expr):
+        return _float_literal(sp.pi)
+
+    def _print_Rational(self, expr):
+        return f"({_float_literal(expr.p)}/{_float_literal(expr.q)})"
+
+
+class NumpyPrinter(NumPyPrinter):
+    def _print_Pi(self, expr):
+        return _float_literal(sp.pi)
+
+    def _print_Rational(self, expr):
+        return f"({expr.p}/{expr.q})"
+
+
+class CasadiPrinter(PythonCodePrinter):
+    """Python syntax over CasADi SX: elementary functions from the `ca` namespace."""
+
+    _functions = {"sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh", "tanh",
+                  "exp", "log", "sqrt", "fabs"}
+
+    def _print_Function(self, expr):
+        name = expr.func.__name__
+        if name in self._functions:
+            return f"ca.{name}({', '.join(self._print(a) for a in expr.args)})"
+        raise ValueError(f"no CasADi counterpart for {name}")
+
+    _print_sin = _print_cos = _print_tan = _print_atan = _print_atan2 = _print_Function
+    _print_exp = _print_log = _print_sinh = _print_cosh = _print_tanh = _print_Function
+    _print_asin = _print_acos = _print_Function
+
+    def _print_Pow(self, expr):
+        if expr.exp == sp.Rational(1, 2):
+            return f"ca.sqrt({self._print(expr.base)})"
+        return super()._print_Pow(expr, rational=False)
+
+    def _print_Abs(self, expr):
+        return f"ca.fabs({self._print(expr.args[0])})"
+
+    def _print_Pi(self, expr):
+        return _float_literal(sp.pi)
+
+    def _print_Rational(self, expr):
+        return f"({expr.p}/{expr.q})"
+
+
+# --------------------------------------------------------------------------- CSE'd functions
+
+
+@dataclass
+class Output:
+    name: str
+    rows: int
+    cols: int
+    entries: list  # (flat index, printed expression) for non-zero entries, row-major
+
+
+@dataclass
+class Input:
+    name: str
+    symbols: list  # scalar symbol names, in order
+
+
+@dataclass
+class EmittedFunction:
+    name: str
+    doc: str
+    inputs: list[Input]
+    temps: list  # (name, printed expression)
+    outputs: list[Output]
+    ops: int  # operations after CSE
+    ops_before: int  # operations before CSE
+
+
+def _cse(fn: Function):
+    flat = []
+    for _, mat in fn.outputs:
+        flat.extend(list(sp.Matrix(mat)))
+    allowed = {s for _, syms in fn.inputs for s in syms}
+    free = set().union(*[sp.sympify(e).free_symbols for e in flat]) if flat else set()
+    missing = free - allowed
+    if missing:
+        raise ValueError(f"{fn.name}: symbols not among its inputs: {sorted(map(str, missing))}")
+    ops_before = sum(sp.count_ops(e) for e in flat)
+    temps, reduced = sp.cse(flat, symbols=sp.numbered_symbols("t"), order="canonical")
+    ops = sum(sp.count_ops(e) for _, e in temps) + sum(sp.count_ops(e) for e in reduced)
+    return temps, reduced, ops, ops_before
+
+
+def cse_function(fn: Function, printer) -> EmittedFunction:
+    temps, reduced, ops, ops_before = _cse(fn)
+    return _printed(fn, temps, reduced, ops, ops_before, printer)
+
+
+def _printed(fn, temps, reduced, ops, ops_before, printer) -> EmittedFunction:
+    outs, k = [], 0
+    for name, mat in fn.outputs:
+        mat = sp.Matrix(mat)
+        entries = []
+        for idx in range(mat.rows * mat.cols):
+            e = reduced[k + idx]
+            if e != 0:
+                entries.append((idx, printer.doprint(e)))
+        outs.append(Output(name, mat.rows, mat.cols, entries))
+        k += mat.rows * mat.cols
+    return EmittedFunction(
+        name=fn.name, doc=fn.doc,
+        inputs=[Input(n, [str(s) for s in syms]) for n, syms in fn.inputs],
+        temps=[(str(t), printer.doprint(e)) for t, e in temps],
+        outputs=outs, ops=int(ops), ops_before=int(ops_before))
+
+
+# --------------------------------------------------------------------------- files
+
+
+def tool_versions() -> dict[str, str]:
+    return {name: importlib_metadata.version(name) for name in TOOL_VERSIONS}
+
+
+def input_hash(model_module_file: Path) -> str:
+    """SHA-256 of what makes the generated files: derive/ sources (the model's among them),
+    the templates and the versions of the symbolic tools."""
+    h = hashlib.sha256()
+    files = sorted(set((ROOT / "derive").rglob("*.py")) | set(TEMPLATES.glob("*.j2")) | {Path(model_module_file)})
+    for f in files:
+        h.update(str(f.relative_to(ROOT)).encode())
+        h.update(b"\0")
+        h.update(f.read_bytes())
+    h.update(json.dumps(tool_versions(), sort_keys=True).encode())
+    return h.hexdigest()
+
+
+def environment() -> jinja2.Environment:
+    return jinja2.Environment(
+        loader=jinja2.FileSystemLoader(str(TEMPLATES)),
+        undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True,
+        keep_trailing_newline=True, autoescape=False)
+
+
+def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=None) -> list[Path]:
+    """Write the generated package of one model into outdir (created, files overwritten)."""
+    import importlib
+
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    module_file = Path(importlib.import_module(model.module).__file__)
+    digest = input_hash(module_file)
+    env = environment()
+    printers = {"c": CPrinter(), "numpy": NumpyPrinter(), "casadi": CasadiPrinter()}
+    emitted = {k: [] for k in printers}
+    for fn in functions:
+        temps, reduced, ops, ops_before = _cse(fn)
+        for key, printer in printers.items():
+            emitted[key].append(_printed(fn, temps, reduced, ops, ops_before, printer))
+    source = str(module_file.relative_to(ROOT))
+    common = dict(model=model.name, title=model.title, paper=model.source, source=source,
+                  digest=digest, versions=tool_versions(), prefix=model.name)
+    files = {
+        "casadi_functions.py": ("casadi_functions.py.j2", emitted["casadi"]),
+        "numpy_functions.py": ("numpy_functions.py.j2", emitted["numpy"]),
+        f"{model.name}.h": ("model.h.j2", emitted["c"]),
+        f"{model.name}.c": ("model.c.j2", emitted["c"]),
+        "__init__.py": ("package_init.py.j2", emitted["numpy"]),
+    }
+    written = []
+    for fname, (template, funcs) in files.items():
+        text = env.get_template(template).render(template=template, functions=funcs, **common)
+        path = outdir / fname
+        path.write_text(text)
+        written.append(path)
+    meta = dict(metadata)
+    meta["generated"] = {"by": "derive", "source": source, "input_hash": digest,
+                         "versions": tool_versions()}
+    meta["functions"] = {
+        f.name: {"doc": f.doc, "inputs": {i.name: i.symbols for i in f.inputs},
+                 "outputs": {o.name: [o.rows, o.cols] for o in f.outputs},
+                 "ops": f.ops, "ops_before_cse": f.ops_before}
+        for f in emitted["numpy"]}
+    path = outdir / "metadata.json"
+    path.write_text(json.dumps(meta, indent=1, sort_keys=True) + "\n")
+    written.append(path)
+    return written

@@ -1,0 +1,3 @@
+from gyro.cli import main
+import sys
+sys.exit(main())

@@ -232,8 +232,7 @@ def _numeric_substitutions(system: BaselineSystem, params: dict) -> dict:
     return subs
 
 
-def linearize_full(system: BaselineSystem, params: dict, q0: dict,
-                   progress=None):
+def linearize_full(system: BaselineSystem, params: dict, q0: dict):
     """Linearise all 11 Lagrange equations about the steady motion.
 
     Returns (M11, D11, K11, spin_rate) as float arrays in the coordinate
@@ -289,7 +288,7 @@ def baseline_operator(params: dict, q0: dict, system: BaselineSystem = None,
             _CACHED_SYSTEM = derive_baseline(progress or (lambda s: None))
         system = _CACHED_SYSTEM
 
-    M11, D11, K11, _ = linearize_full(system, params, q0, progress)
+    M11, D11, K11, _ = linearize_full(system, params, q0)
 
     s = COORD_NAMES_11.index("gamma3")
     keep = [COORD_NAMES_11.index(name) for name in COORD_NAMES_10]
@@ -379,10 +378,12 @@ def run_with_timeout(seconds: float) -> dict | None:
     cmd = [sys.executable, __file__, "--json"]
     try:
         out = subprocess.run(cmd, capture_output=True, text=True,
-                             timeout=seconds, check=True)
+                             timeout=seconds)
     except subprocess.TimeoutExpired:
         print(f"did not finish within {seconds:g} s")
         return None
+    if out.returncode != 0:
+        raise RuntimeError("baseline child process failed:\n" + out.stderr[-4000:])
     result = json.loads(out.stdout.strip().splitlines()[-1])
     _report(result)
     return result

@@ -27,10 +27,10 @@ def equilibrium(model: Model, params: np.ndarray, tol: float = 1e-14, max_iter: 
     nf = model.numpy
     reduced = model.meta["reduced"]
     idx = [reduced.index(c) for c in model.meta["equilibrium_coordinates"]]
-    qe = np.asarray(nf.equilibrium_approx(params), dtype=float).reshape(-1)
+    qe = np.asarray(nf.equilibrium_approx(params), dtype=float)
     qe = np.where(np.isfinite(qe), qe, 0.0)  # (2.2) divides by g: at g = 0 start from zero
     for _ in range(max_iter):
-        r = np.asarray(nf.equilibrium_residual(params, qe)).reshape(-1)[idx]
+        r = np.asarray(nf.equilibrium_residual(params, qe))[idx]
         _, _, K = nf.operator(params, qe)
         Kee = np.asarray(K)[np.ix_(idx, idx)]
         # r(q + dq) = r(q) - K dq  (r = dR/dq, K = -d2R/dq2)
@@ -39,7 +39,7 @@ def equilibrium(model: Model, params: np.ndarray, tol: float = 1e-14, max_iter: 
         scale = np.maximum(np.abs(qe), 1e-300)
         if np.all(np.abs(dq) <= tol * scale + 1e-300):
             return qe
-    r = np.asarray(nf.equilibrium_residual(params, qe)).reshape(-1)[idx]
+    r = np.asarray(nf.equilibrium_residual(params, qe))[idx]
     if np.max(np.abs(r)) > 1e-9 * (1 + np.max(np.abs(params))):
         raise EquilibriumError(f"Newton's method did not converge (residual {np.max(np.abs(r)):.3e})")
     return qe

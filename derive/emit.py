@@ -44,8 +44,9 @@ class CPrinter(C99CodePrinter):
     def _print_Pow(self, expr):
         b, e = expr.base, expr.exp
         if e.is_Integer and 2 <= abs(int(e)) <= 4:
+            # parenthesised: the Mul printer puts a power in a denominator as it is (x/(A*A*A))
             prod = "*".join([self.parenthesize(b, 1000)] * abs(int(e)))
-            return prod if e > 0 else f"1.0/({prod})"
+            return f"({prod})" if e > 0 else f"(1.0/({prod}))"
         if e == sp.Rational(1, 2):
             return f"sqrt({self._print(b)})"
         if e == -sp.Rational(1, 2):

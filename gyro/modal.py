@@ -27,7 +27,8 @@ def equilibrium(model: Model, params: np.ndarray, tol: float = 1e-14, max_iter: 
     nf = model.numpy
     reduced = model.meta["reduced"]
     idx = [reduced.index(c) for c in model.meta["equilibrium_coordinates"]]
-    qe = np.asarray(nf.equilibrium_approx(params), dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        qe = np.asarray(nf.equilibrium_approx(params), dtype=float)
     qe = np.where(np.isfinite(qe), qe, 0.0)  # (2.2) divides by g: at g = 0 start from zero
     for _ in range(max_iter):
         r = np.asarray(nf.equilibrium_residual(params, qe))[idx]
@@ -65,9 +66,11 @@ def refine(M, D, K, lam: complex, iters: int = 8) -> tuple[complex, float]:
         x, y = Vh[-1].conj(), U[:, -1]
         dJ = 2 * M * lam + D
         den = y.conj() @ dJ @ x
-        if den == 0:
+        res = y.conj() @ J @ x
+        if den == 0:  # a root where J' annihilates the null vector (e.g. lambda = 0 at g = 0)
+            step = 0.0 if res == 0 else np.inf
             break
-        d = (y.conj() @ J @ x) / den
+        d = res / den
         lam = lam - d
         step = abs(d) / max(abs(lam), 1e-300)
         if step < 1e-15:

@@ -148,3 +148,27 @@ def test_block_polynomials_are_the_determinants(tg_derivation):
             poly = sum(c.xreplace(pt) * (pv**2)**k for k, c in enumerate(coeffs))
             assert sp.simplify(det - poly) == 0
     assert [len(c) - 1 for c in v.charpoly] == [4, 6]
+
+
+def test_delta1_is_det_J_prime_with_the_last_term_read_g_m_l(tg_derivation):
+    """(3.1): det J'(p) at u = 0, p^2 = -x, is -l^2 m^2 m_c (omega_p^2 - x) Delta1(x), with the
+    printed last term 'g m l^2' read 'g m l' (the l^2 reading is not even a constant multiple)."""
+    from derive.pipeline import Z_SYMBOL
+
+    v = tg_derivation.variants["paper"]
+    blk = [[tg.REDUCED[i] for i in b] for b in v.blocks].index(tg.BLOCKS[0])
+    x = sp.Symbol("x")
+    det = sum(c * Z_SYMBOL**k for k, c in enumerate(v.charpoly[blk])).subs(Z_SYMBOL, -x).subs(tg.u, 0)
+    m, M, l, l1, l2, I2, g = tg.m, tg.M, tg.l, tg.l1, tg.l2, tg.I2, tg.g
+    m_s, m_c, wp2 = m * M / (m + M), m + M, tg.Kp / tg.m
+    l_c, I2p = (m * l2 + M * l1) / (m + M), tg.I2p
+
+    def delta1(last):
+        return (x**3 * I2 * M / m_c
+                - x**2 * (wp2 * (I2 + m_s * (l1 - l2)**2) + g / l * (m_s * (l1 - l2) * l + M * l1**2 + M * l1 * l + I2))
+                + x * g / l * (wp2 * (m_c * l_c * l + I2p) + g * (M * l1 - m * l - m * l2))
+                - (g / l)**2 * (wp2 * m_c * l_c * l - g * last))
+
+    ratio = sp.cancel(det / ((wp2 - x) * delta1(m * l)))
+    assert sp.simplify(ratio + l**2 * m**2 * m_c) == 0
+    assert sp.cancel(det / ((wp2 - x) * delta1(m * l**2))).has(x)

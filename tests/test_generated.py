@@ -40,16 +40,24 @@ def _random_inputs(fn, model, rng):
 
 
 def term_scale(expr):
-    """The expression with every term taken in absolute value: the size of the largest
-    intermediate sums its evaluation goes through. Floating-point evaluation errs by a few
-    ulps of this, whatever cancellation leaves of the value itself."""
+    """A first-order bound on the size of what evaluating expr goes through: every term of a
+    sum in absolute value, and through a power or function the scale of its argument
+    propagated by the derivative (|f(x)| + |f'(x)| scale(x)). Floating-point evaluation
+    errs by a few ulps of this, however much cancellation leaves of the value itself."""
     if expr.is_Number or expr.is_Symbol or expr.is_NumberSymbol:
         return sp.Abs(expr)
     if expr.is_Add or expr.is_Mul:
         return expr.func(*[term_scale(a) for a in expr.args])
     if expr.is_Pow:
-        return sp.Pow(term_scale(expr.base), expr.exp)
-    return sp.Abs(expr)  # sin, cos, sqrt of something: its own size
+        b, e = expr.base, expr.exp
+        if e.is_Integer and e > 0:
+            return sp.Pow(term_scale(b), e)
+        return sp.Abs(expr) + sp.Abs(e * sp.Pow(b, e - 1)) * term_scale(b)
+    if len(expr.args) == 1:
+        t = sp.Dummy()
+        deriv = sp.diff(expr.func(t), t).subs(t, expr.args[0])
+        return sp.Abs(expr) + sp.Abs(deriv) * term_scale(expr.args[0])
+    raise TypeError(f"no term scale for {expr.func}")
 
 
 _LAMBDAS = {}
@@ -162,3 +170,17 @@ def test_generated_is_current_and_deterministic_across_hash_seeds(tmp_path):
 def test_generated_c_has_op_counts():
     text = (GENERATED / MODEL / f"{MODEL}.c").read_text()
     assert text.count("Total ops:") == text.count("\n{\n")
+
+
+def test_c_printer_parenthesises_powers_in_denominators():
+    """x * y**-3 once printed as x/(y)*(y)*(y): small integer powers are products and must
+    stay grouped wherever the Mul printer places them. These C expressions are Python too."""
+    from derive.emit import CPrinter
+
+    x, y, z = sp.symbols("x y z")
+    pr = CPrinter()
+    vals = {"x": 1.7, "y": 0.3, "z": 2.9, "sqrt": np.sqrt, "pow": pow}
+    for e in (x * y**-3, x / (y**2 * z**3), (x + y)**-2 * z, x**4 / y**4, 1 / (x * y)**2, y**sp.Rational(-1, 2)):
+        got = eval(pr.doprint(e), vals)
+        want = float(e.subs({x: 1.7, y: 0.3, z: 2.9}))
+        assert abs(got / want - 1) < 1e-14, (e, pr.doprint(e))

@@ -244,13 +244,142 @@ def print_corrections(p):
 # ----------------------------------------------------------------------------- section 3
 
 
+def L_poly(z, b):
+    """(3.8): L(z, b), cubic in z = omega^2; its roots are frequencies of the free gyroscope
+    with elastic bearings, with the casing inertia parameter b."""
+    wy2, W2 = omega_y2, Omega**2
+    return (z**3 * (b - 1) * (a - 1)
+            - z**2 * ((2 * a * b - a - b) * wy2 + W2 * (a - 1) * (b - 1))
+            + z * (W2 * wy2 * (a + b - 2) + wy2**2 * a * b)
+            - wy2**2 * W2)
+
+
 def section3_formulas():
-    """The paper's approximate natural frequencies (3.2)-(3.28): name -> expression, and
-    name -> the equation it comes from with the OCR reading taken."""
-    f, d = {}, {}
-    f["omega5"] = sp.sqrt(omega_p2)
-    d["omega5"] = "(3.7) omega5 = omega_p"
-    return f, d
+    """The paper's approximate frequencies (3.2)-(3.28) and their abbreviations.
+
+    Returns (name -> expression, name -> the equation and the OCR reading taken). Names
+    ending in `_printed` are formulas as printed where the derivation shows them wrong;
+    the name without the suffix is the corrected formula (evidence: docs/frequencies.md).
+    Names ending in `_eq` take the operator at the exact equilibrium instead of q = 0.
+    """
+    F, doc = {}, {}
+
+    def put(name, expr, note):
+        F[name], doc[name] = expr, note
+        return expr
+
+    m_s = put("m_star", m * M / (m + M), "(3.1): reduced mass m_* = m M/(m + M)")
+    put("m_c", m_c, "(2.4): m_c = m + M")
+    put("l_c", l_c, "(2.2): l_c = (m l2 + M l1)/m_c")
+    put("G", G, "(2.4): G = m_c l_c g")
+    put("I2p", I2p, "(2.4): I2' = I2 + m l2^2 + M l1^2")
+    put("a", a, "(2.4): a = (A + I3)/A")
+    put("b0", b0, "(2.4): b0 = (m l2^2 + M l1^2 + A + I1)/A")
+    wy = put("omega_y", sp.sqrt(omega_y2), "(2.4): omega_y^2 = K_gamma/A (printed omega_n in the example)")
+    wp = put("omega_p", sp.sqrt(omega_p2), "(2.4): omega_p^2 = K_p/m")
+    w0 = put("omega_0", sp.sqrt(omega_02), "(2.4): omega_0^2 = K_0/m")
+    W = put("Omega", Omega, "(2.4): Omega = H/A")
+    put("u2", u2, "(1.3): u2 = u cos phi")
+    b1 = put("b1", 1 + (I1 + m_s * (l1 - l2)**2) / A, "(3.8): b' = 1 + [I1 + m_*(l1 - l2)^2]/A")
+    b2 = put("b2", 1 + I1 / A, "(3.8): b'' = 1 + I1/A")
+    put("delta_b", m_s * (l1 - l2)**2 / A, "(3.8): delta_b = b' - b'' = m_*(l1 - l2)^2/A")
+    put("k", W / wy, "(3.16): k = Omega/omega_y")
+    put("mu1", omega_y2 / W**2, "(3.26): mu1 = k^-2 = omega_y^2/Omega^2")
+    put("eps1", u * sp.sqrt(l / g), "section 3: eps1 = u sqrt(L*/g) with L* = l")
+    put("eps2", g / (l * omega_p2), "(3.3): eps2 = g/(l omega_p^2)")
+    put("eps3", g / (l * omega_y2), "before (3.8): eps3 = g/(l omega_y^2)")
+    put("kappa", (b1 - 1) * K0 / ((b2 - 1) * omega_y2 * m_s), "(3.15): kappa")
+    w0p = put("omega_0p", sp.sqrt(K0 * (b1 - 1) / (m_s * (b2 - 1))), "(3.26): omega_0'^2 = K0 (b'-1)/(m_* (b''-1))")
+
+    # omega1, (3.2); "K_v" read as K_gamma
+    put("omega1_printed", sp.sqrt(u2**2 + Kgamma * u2 * G / ((Kgamma + G) * H)
+                                  * (1 + Kp * m**2 * g**2 / (K0 * (Kp * G - m**2 * g**2)))),
+        "(3.2) as printed (K_v read K_gamma): drops the azimuth inertia (A + I3) S/H^2 and "
+        "has the axial-bearing bracket wrong")
+    Gk = G - m**2 * g**2 / K0
+    S = Kgamma * Gk / (Kgamma + Gk)
+    put("omega1", sp.sqrt(u2**2 + u2 * S / (H + (A + I3) * S / H)),
+        "(3.2) corrected from the slowest root of det J'': G' = G - m^2 g^2/K0 (axial "
+        "bearing), S = K_gamma G'/(K_gamma + G') (rotor spring in series), H -> H + (A+I3) S/H")
+    Ge = G + m**2 * g**2 / Kp - m**2 * g**2 / K0
+    Se = Kgamma * Ge / (Kgamma + Ge)
+    put("omega1_eq", sp.sqrt(u2**2 + u2 * Se / (H + (A + I3) * Se / H)),
+        "(3.2) corrected, at the exact equilibrium: the rotor's radial sag m g/K_p adds "
+        "m^2 g^2/K_p to G")
+
+    # omega2..omega4, (3.3)-(3.6)
+    c2 = I2 + m_s * (l1 - l2)**2
+    d2 = m_s * (l1 - l2) * l + M * l1**2 + M * l1 * l + I2
+    e1 = m_c * l_c * l + I2p
+    lead = Kp / m_s * (1 + m_s * (l1 - l2)**2 / I2)
+    put("omega2_printed", sp.sqrt(lead + g / l * (d2 * m_c / (I2 * M) - m_c * l_c * l / c2)),
+        "(3.4) as printed: second term -m_c l_c l/[I2 + m_*(l1-l2)^2]; error O(eps2)")
+    put("omega2", sp.sqrt(lead + g / l * (d2 * m_c / (I2 * M) - e1 / c2)),
+        "(3.4) corrected by first-order perturbation of (3.3): -(m_c l_c l + I2')/[I2 + "
+        "m_*(l1-l2)^2]; error O(eps2^2)")
+    disc = (I2p - m_c * l_c * l)**2 + 4 * m_c**2 * l_c**3 * l
+    th1 = put("theta1", (e1 - sp.sqrt(disc)) / (2 * c2), "(3.6): smaller root theta_1")
+    th2 = put("theta2", (e1 + sp.sqrt(disc)) / (2 * c2), "(3.6): larger root theta_2")
+
+    def Q(t):  # (3.6): Q(theta) as printed
+        return (I2 * M * t**3 / m_c - (I2 + M * l1 * l + M * l1**2 + m_s * (l1 - l2) * l) * t**2
+                + (M * l1 * l - m * l**2 - m * l2 * l) * t + m * l**2)
+
+    put("omega3", sp.sqrt(g * th1 / l - (g / (l * wp))**2 * Q(th1) / sp.sqrt(disc)),
+        "(3.5) as printed, (g/l omega_p)^2 read g^2/(l^2 omega_p^2); error O(eps2^2)")
+    put("omega4", sp.sqrt(g * th2 / l + (g / (l * wp))**2 * Q(th2) / sp.sqrt(disc)),
+        "(3.6) as printed; error O(eps2^2)")
+    sag = {l2: l2 + m * g / Kp}
+    for name in ("omega2", "omega3", "omega4"):
+        put(name + "_eq", F[name].xreplace(sag),
+            f"{doc[name].split(' ')[0]} at the exact equilibrium: l2 -> l2 + m g/K_p (the "
+            "rotor's radial sag, an O(eps2) effect the linearisation at q = 0 drops)")
+
+    put("omega5", wp, "(3.7): omega5 = omega_p")
+    put("omega6", sp.sqrt(g / l * (1 - g / l * (m_c * l_c**2 / A * (a / W**2 + 1 / wy**2)
+                                                 + m / (m_c * w0**2)))),
+        "(3.9), left side printed omega_0^2 read omega_6^2; error O(kappa6^2), "
+        "kappa6 = G l_c/(l K_gamma)")
+
+    def s8(b):  # (3.14)
+        return omega_y2 * W**2 / (a * b * omega_y2 + W**2 * (b - 1))
+
+    def s9(b):  # (3.14)
+        return ((W**2 * (b - 1)**3 + b**2 * (b - a) * omega_y2) * omega_y2
+                / ((W**2 * (b - 1)**2 * (a - 1) + b * (b - a) * omega_y2) * (b - 1)))
+
+    def s10(b):  # (3.14): the sum of the roots of L minus the other two
+        return (a / (a - 1) + b / (b - 1)) * omega_y2 - (s8(b) + s9(b)) + W**2
+
+    for tag, b, label in (("b1", b1, "b'"), ("b2", b2, "b''")):
+        for k_, fn in ((8, s8), (9, s9), (10, s10)):
+            put(f"omega_star{k_}_{tag}", sp.sqrt(fn(b)), f"(3.14): omega_*{k_}({label}), a root of L(z, b), b > a")
+    put("omega_star7", sp.sqrt(K0 / m_s), "(3.11): axial frequency sqrt(K0/m_*), exact when delta_b = 0")
+
+    def pair(sb2, sb1, sign):
+        return sp.sqrt((w0p**2 + sb2 + sign * sp.sqrt((w0p**2 - sb2)**2 + 4 * w0p**2 * (sb2 - sb1))) / 2)
+
+    put("omega7", pair(s8(b2), s8(b1), +1), "(3.26), + branch; OCR omega_*s read omega_*8")
+    put("omega8", w0p * sp.sqrt(s8(b1)) / F["omega7"],
+        "(3.26), - branch (first nutation), as omega_0' omega_*8(b')/omega7 (the product "
+        "of the two roots): the same value without cancellation")
+    put("omega9", sp.sqrt(s9(b1)), "(3.26): omega9 = omega_*9(b')")
+    put("omega10", sp.sqrt(s10(b1)), "(3.26): omega10 = omega_*10(b')")
+    put("omega7_smallk", sp.sqrt(s8(b1)), "(3.28), small k: omega7 = omega_*8(b')")
+    put("omega8_smallk", sp.sqrt(s10(b1)), "(3.28), small k: omega8 = omega_*10(b')")
+    put("omega9_smallk", pair(s9(b2), s9(b1), +1), "(3.28), small k: + branch with omega_*9")
+    put("omega10_smallk", w0p * sp.sqrt(s9(b1)) / F["omega9_smallk"],
+        "(3.28), small k: - branch with omega_*9, through the product of the roots")
+    put("omega7_K0inf", sp.sqrt(w0p**2 + s8(b2) - s8(b1)), "after (3.28): K0 -> oo limit of omega7")
+    put("omega_rigid", W / sp.sqrt(a * b1),
+        "after (3.28): lim omega_*8(b') as K_gamma -> oo, Omega/sqrt(a b') (printed "
+        "Omega/sqrt(I1 b^2), read as such)")
+    # the quartic (3.10) K0 L(z, b') - z m_* L(z, b'') = 0, coefficients lowest first
+    zs = sp.Symbol("z")
+    quartic = sp.Poly(sp.expand(K0 * L_poly(zs, b1) - zs * m_s * L_poly(zs, b2)), zs)
+    for k_, c in enumerate(reversed(quartic.all_coeffs())):
+        put(f"quartic_c{k_}", c, f"(3.10): coefficient of z^{k_} in K0 L(z,b') - z m_* L(z,b'')")
+    return F, doc
 
 
 # ----------------------------------------------------------------------------- the model

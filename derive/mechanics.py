@@ -347,3 +347,22 @@ def null_lagrangian_residual(dL, q, qd, qdd) -> list:
     """Lagrange equations of a Lagrangian difference, expanded: all zero iff dL is a total
     time derivative plus a constant (it then changes no equation of motion)."""
     return [_sp(se.expand(e)) for e in _lagrange_se(_se(dL), _se_list(q), _se_list(qd), _se_list(qdd))]
+
+
+def numeric_equilibrium(equations, unknowns, values: dict, guess: dict, dps: int = 40) -> dict:
+    """Solve equilibrium equations numerically in arbitrary precision (mpmath.findroot).
+
+    `equations` are expressions in `unknowns` and parameters; `values` gives the parameters
+    (numbers), `guess` a start for each unknown (e.g. the paper's approximation). Returns
+    unknown -> mpf. A reference for the runtime's double-precision Newton iteration."""
+    import mpmath as mp
+
+    with mp.workdps(dps):
+        eqs = [sp.sympify(e).subs({k: sp.Float(v, dps) for k, v in values.items()}) for e in equations]
+        eqs = [e for e in eqs if e != 0]
+        f = sp.lambdify(list(unknowns), eqs, modules="mpmath")
+        jac = sp.lambdify(list(unknowns), sp.Matrix(eqs).jacobian(list(unknowns)), modules="mpmath")
+        x0 = [mp.mpf(guess[u]) for u in unknowns]
+        sol = mp.findroot(lambda *x: f(*x), x0, J=lambda *x: jac(*x), tol=mp.mpf(10) ** (-dps + 5))
+        sol = [sol] if len(unknowns) == 1 else list(sol)
+    return dict(zip(unknowns, sol))

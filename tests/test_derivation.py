@@ -172,3 +172,23 @@ def test_delta1_is_det_J_prime_with_the_last_term_read_g_m_l(tg_derivation):
     ratio = sp.cancel(det / ((wp2 - x) * delta1(m * l)))
     assert sp.simplify(ratio + l**2 * m**2 * m_c) == 0
     assert sp.cancel(det / ((wp2 - x) * delta1(m * l**2))).has(x)
+
+
+@pytest.mark.parametrize("over", [{}, {"phi": 5}, {"phi": 89}])
+def test_runtime_equilibrium_matches_a_40_digit_solution(tg_derivation, tg_model, over):
+    """The runtime's Newton iteration (double precision, generated code) against mpmath's
+    findroot on the un-CSE'd symbolic equilibrium equations, 40 digits."""
+    from gyro import load
+    from gyro.modal import equilibrium
+
+    m = load("torsion_gyrocompass")
+    values = m.parameters(over)
+    P = m.vector(values)
+    even = tg_derivation.even
+    eqs = [tg_derivation.equilibrium_residual[tg.REDUCED.index(str(x))] for x in even]
+    approx = m.numpy.equilibrium_approx(P)
+    ref = mech.numeric_equilibrium(eqs, even, {p.symbol: values[p.name] for p in tg_model.parameters},
+                                   dict(zip(even, approx)))
+    got = equilibrium(m, P)
+    for x, g_ in zip(even, got):
+        assert abs(g_ / float(ref[x]) - 1) < 1e-12, (x, g_, ref[x])

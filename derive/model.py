@@ -81,6 +81,7 @@ class Model:
     module: str  # the Python module that defines it (its file is part of the input hash)
     parameters: list[Parameter]
     coordinates: list[str]
+    coordinate_units: dict  # coordinate -> unit ('m', 'rad')
     q: list
     qd: list
     qdd: list

@@ -233,6 +233,7 @@ def metadata(d: Derivation) -> dict:
             {"name": p.name, "unit": p.unit, "default": p.default, "description": p.description,
              "kind": p.kind, "bounds": list(p.bounds)} for p in model.parameters],
         "coordinates": model.coordinates,
+        "coordinate_units": model.coordinate_units,
         "cyclic": {c: str(s) for c, s in model.cyclic.items()},
         "reduced": order,
         "equilibrium_coordinates": [str(x) for x in d.even],

@@ -11,6 +11,8 @@ import argparse
 import json
 import sys
 
+import numpy as np
+
 from gyro.models import ParameterError, load
 
 EXIT_USAGE = 2
@@ -40,6 +42,8 @@ def _frequencies(args) -> int:
     model = load(args.model)
     values = model.parameters(_parse_sets(args.set))
     result = natural_frequencies(model, values)
+    if not np.all(np.isfinite(result.frequencies + result.eigenvalues_re)):
+        raise FloatingPointError("a frequency is not finite")
     if args.json:
         print(json.dumps({
             "model": model.name,
@@ -47,7 +51,7 @@ def _frequencies(args) -> int:
             "frequencies": result.frequencies,
             "equilibrium": result.equilibrium,
             "eigenvalues_re": result.eigenvalues_re,
-        }))
+        }, allow_nan=False))
         return 0
     print(f"{model.meta['title']} ({model.name})")
     print("natural frequencies of the exact operator about the exact equilibrium:")
@@ -86,12 +90,18 @@ def main(argv=None) -> int:
 
     args = build_parser().parse_args(argv)
     try:
-        return args.run(args)
+        with np.errstate(all="ignore"):  # failures are caught below, one line each
+            return args.run(args)
     except ParameterError as exc:
         print(f"gyro: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
     except EquilibriumError as exc:
         print(f"gyro: error: no equilibrium found: {exc}", file=sys.stderr)
+        return 1
+    except (np.linalg.LinAlgError, FloatingPointError, ValueError, OverflowError) as exc:
+        # valid input whose numbers the double-precision solvers cannot handle (e.g. 1e300)
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        print(f"gyro: error: numerical failure at these parameters ({msg})", file=sys.stderr)
         return 1
     except BrokenPipeError:  # output closed early (e.g. piped into head)
         sys.stderr.close()

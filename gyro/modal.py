@@ -22,28 +22,51 @@ class EquilibriumError(RuntimeError):
     pass
 
 
-def equilibrium(model: Model, params: np.ndarray, tol: float = 1e-14, max_iter: int = 50) -> np.ndarray:
-    """Relative equilibrium on the symmetric set (metadata 'equilibrium_coordinates')."""
+MAX_ANGLE_STEP = 0.2  # rad: Newton steps on angles are damped to stay on the branch of (2.2)
+
+
+def _wrap(angle):
+    return (angle + np.pi) % (2 * np.pi) - np.pi
+
+
+def equilibrium(model: Model, params: np.ndarray, tol: float = 1e-14, max_iter: int = 100) -> np.ndarray:
+    """Relative equilibrium on the symmetric set (metadata 'equilibrium_coordinates').
+
+    Newton's method from the paper's approximation (2.2) where the model has one (zero
+    otherwise), with the stiffness K as the Jacobian. Steps on angles are damped to
+    MAX_ANGLE_STEP so that the iteration stays on the branch it starts from, and angles are
+    returned in (-pi, pi]."""
     nf = model.numpy
     reduced = model.meta["reduced"]
-    idx = [reduced.index(c) for c in model.meta["equilibrium_coordinates"]]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        qe = np.asarray(nf.equilibrium_approx(params), dtype=float)
-    qe = np.where(np.isfinite(qe), qe, 0.0)  # (2.2) divides by g: at g = 0 start from zero
+    names = model.meta["equilibrium_coordinates"]
+    idx = [reduced.index(c) for c in names]
+    units = model.meta.get("coordinate_units", {})
+    is_angle = np.array([units.get(c) == "rad" for c in names])
+    if hasattr(nf, "equilibrium_approx"):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            qe = np.asarray(nf.equilibrium_approx(params), dtype=float)
+        qe = np.where(np.isfinite(qe), qe, 0.0)  # (2.2) divides by g: at g = 0 start from zero
+    else:
+        qe = np.zeros(len(names))
     for _ in range(max_iter):
         r = np.asarray(nf.equilibrium_residual(params, qe))[idx]
         _, _, K = nf.operator(params, qe)
         Kee = np.asarray(K)[np.ix_(idx, idx)]
         # r(q + dq) = r(q) - K dq  (r = dR/dq, K = -d2R/dq2)
         dq = np.linalg.lstsq(Kee, r, rcond=None)[0]
+        big = np.max(np.abs(dq[is_angle]), initial=0.0)
+        if big > MAX_ANGLE_STEP:
+            dq = dq * (MAX_ANGLE_STEP / big)
         qe = qe + dq
-        scale = np.maximum(np.abs(qe), 1e-300)
-        if np.all(np.abs(dq) <= tol * scale + 1e-300):
-            return qe
-    r = np.asarray(nf.equilibrium_residual(params, qe))[idx]
-    if np.max(np.abs(r)) > 1e-9 * (1 + np.max(np.abs(params))):
-        raise EquilibriumError(f"Newton's method did not converge (residual {np.max(np.abs(r)):.3e})")
-    return qe
+        if not np.all(np.isfinite(qe)):
+            raise EquilibriumError("Newton's method diverged")
+        if np.all(np.abs(dq) <= tol * np.maximum(np.abs(qe), 1e-300) + 1e-300):
+            break
+    else:
+        r = np.asarray(nf.equilibrium_residual(params, qe))[idx]
+        if np.max(np.abs(r)) > 1e-9 * (1 + np.max(np.abs(params))):
+            raise EquilibriumError(f"Newton's method did not converge (residual {np.max(np.abs(r)):.3e})")
+    return np.where(is_angle, _wrap(qe), qe)
 
 
 def _companion_eigenvalues(M, D, K):
@@ -102,20 +125,46 @@ class ModalResult:
             return cls(**json.load(fh))
 
 
+def representatives(lams: np.ndarray, n: int) -> np.ndarray:
+    """One root of each pair of the 2n eigenvalues of a gyroscopic system.
+
+    The spectrum is symmetric under lambda -> -lambda and lambda -> conj(lambda). A root
+    that is essentially imaginary (|Im| > |Re|) is represented by its member with Im > 0 (a
+    flutter quadruple gives two, growing and decaying); an essentially real pair +-sigma
+    (divergent instability) by its member with Re >= 0, so that no growth rate is hidden."""
+    imaginary = np.abs(lams.imag) > np.abs(lams.real)
+    keep = np.where(imaginary, lams.imag > 0, lams.real >= 0)
+    chosen = lams[keep]
+    if len(chosen) != n:  # zeros or rounding broke the symmetry: take the n most "upper"
+        key = np.where(imaginary, lams.imag, lams.real)
+        chosen = lams[np.argsort(-key)[:n]]
+    return chosen
+
+
+def refine_all(M, D, K, lams: np.ndarray, chosen: np.ndarray):
+    """Refine each chosen root; keep a refinement only if it stays within half the distance
+    to the nearest other eigenvalue (otherwise Newton has left the root's basin)."""
+    roots, errs = [], []
+    for lam in chosen:
+        others = lams[np.abs(lams - lam) > 0]
+        gap = np.min(np.abs(others - lam)) if len(others) else np.inf
+        new, err = refine(M, D, K, complex(lam))
+        if abs(new - lam) <= 0.5 * gap:
+            roots.append(new)
+            errs.append(err)
+        else:
+            roots.append(complex(lam))
+            errs.append(np.inf)
+    return np.array(roots), np.array(errs)
+
+
 def natural_frequencies(model: Model, values: dict) -> ModalResult:
     """The natural frequencies of the exact operator about the exact equilibrium."""
     params = model.vector(values)
     qe = equilibrium(model, params)
     M, D, K = (np.asarray(X, dtype=float) for X in model.numpy.operator(params, qe))
     lams = _companion_eigenvalues(M, D, K)
-    n = M.shape[0]
-    # one of each conjugate pair: the root with non-negative imaginary part; a real pair
-    # (divergent instability) gives two real roots of which both are kept
-    order = np.argsort(-lams.imag)
-    upper = lams[order[:n]]
-    refined = [refine(M, D, K, complex(lam)) for lam in upper]
-    roots = np.array([r for r, _ in refined])
-    errs = np.array([e for _, e in refined])
+    roots, errs = refine_all(M, D, K, lams, representatives(lams, M.shape[0]))
     freqs = np.abs(roots.imag)
     idx = np.argsort(freqs)
     return ModalResult(

@@ -42,11 +42,10 @@ class Model:
     """A generated model: its metadata and its NumPy and CasADi functions."""
 
     def __init__(self, name: str):
-        try:
-            pkg = importlib.import_module(f"generated.{name}")
-        except ModuleNotFoundError:
-            known = sorted(p.name for p in GENERATED.iterdir() if (p / "metadata.json").exists())
-            raise ParameterError(f"unknown model {name!r}; known: {', '.join(known)}") from None
+        known = available()
+        if name not in known:
+            raise ParameterError(f"unknown model {name!r}; known: {', '.join(known)}")
+        pkg = importlib.import_module(f"generated.{name}")
         self.name = name
         self.meta = pkg.METADATA
         self.params = [Param(p["name"], p["unit"], p["default"], p["description"], p["kind"],
@@ -82,6 +81,11 @@ class Model:
 
     def vectors(self, batch: list[dict]) -> np.ndarray:
         return np.array([[v[n] for n in self.param_names] for v in batch], dtype=float)
+
+
+def available() -> list[str]:
+    """The generated models: folders of generated/ with a metadata.json."""
+    return sorted(p.name for p in GENERATED.iterdir() if (p / "metadata.json").exists())
 
 
 _CACHE: dict[str, Model] = {}

@@ -68,3 +68,37 @@ def test_unknown_model_and_bad_command_exit_2():
     for args in (["frequencies", "no_such_model"], ["no_such_command"], ["frequencies"]):
         r = gyro(*args)
         assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+
+
+def test_json_is_strict():
+    """No NaN or Infinity: a strict parser reads every output, including the edges."""
+    for sets in ([], ["--set", "g=0"], ["--set", "u=0"], ["--set", "phi=90"], ["--set", "H=0"]):
+        r = gyro("frequencies", "torsion_gyrocompass", "--json", *sets)
+        assert r.returncode == 0, (sets, r.stderr)
+        json.loads(r.stdout, parse_constant=lambda c: (_ for _ in ()).throw(ValueError(c)))
+
+
+@pytest.mark.parametrize("value", ["H=1e300", "m=1e300", "l=1e-300", "Kgamma=1e300"])
+def test_valid_but_numerically_impossible_input_fails_in_one_line(value):
+    """Finite, positive, but beyond double precision: one line, exit 1, no traceback."""
+    r = gyro("frequencies", "torsion_gyrocompass", "--json", "--set", value)
+    assert r.returncode in (0, 1)
+    assert "Traceback" not in r.stderr and len(r.stderr.strip().splitlines()) <= 1
+    if r.returncode == 0:
+        json.loads(r.stdout, parse_constant=lambda c: (_ for _ in ()).throw(ValueError(c)))
+
+
+@pytest.mark.parametrize("name", ["torsion_gyrocompass.numpy_functions", "__init__", "..", "TORSION_GYROCOMPASS"])
+def test_only_generated_models_are_models(name):
+    r = gyro("frequencies", name)
+    assert r.returncode == 2 and "unknown model" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_an_instability_is_reported_not_hidden():
+    """Without gravity (g = 0) the Earth's rotation drives a divergent drift: a real pair
+    +-sigma of order u. The JSON keeps its growing member (eigenvalues_re > 0)."""
+    r = gyro("frequencies", "torsion_gyrocompass", "--json", "--set", "g=0")
+    out = json.loads(r.stdout)
+    growth = max(out["eigenvalues_re"])
+    u = out["params"]["u"]
+    assert 0.01 * u < growth < 10 * u  # 1.1e-5 = 0.15 u

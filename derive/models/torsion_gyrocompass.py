@@ -52,6 +52,7 @@ h = sp.Symbol("h")  # bearing length in (1.10); enters the forcing only
 # ----------------------------------------------------------------------------- coordinates
 # (1.1): sigma = {x1, x2, x3, gamma1, gamma2, gamma3, alpha, beta, gamma, lambda, mu}
 COORDINATES = ["x1", "x2", "x3", "gamma1", "gamma2", "gamma3", "alpha", "beta", "gamma", "lam", "mu"]
+COORDINATE_UNITS = {c: ("m" if c.startswith("x") else "rad") for c in COORDINATES}
 q = sp.symbols(COORDINATES)
 qd = sp.symbols([c + "_d" for c in COORDINATES])
 qdd = sp.symbols([c + "_dd" for c in COORDINATES])
@@ -393,7 +394,7 @@ def build():
     formulas, docs = section3_formulas()
     return Model(
         name=NAME, title=TITLE, source=SOURCE, module=__name__,
-        parameters=PARAMETERS, coordinates=COORDINATES, q=list(q), qd=list(qd), qdd=list(qdd),
+        parameters=PARAMETERS, coordinates=COORDINATES, coordinate_units=COORDINATE_UNITS, q=list(q), qd=list(qd), qdd=list(qdd),
         lagrangian=lagrangian(),
         given_functions=given,
         given_values=list(sp.symbols("F1 F2 F3")),

@@ -181,26 +181,35 @@ def routhian(L, velocity, momentum):
 
 
 def eliminate_cyclic(equations, q, qd, qdd, index, L, momentum):
-    """Substitute the cyclic integral dL/dv_c = beta into the full equations.
+    """Substitute the cyclic integrals dL/dv_c = beta_c into the full equations.
 
-    Returns the equations of the remaining coordinates with v_c taken from the integral
-    dL/dv_c = beta and a_c from its time derivative d/dt(dL/dv_c) = 0. Both are linear in
-    v_c and a_c respectively (the momentum of a cyclic velocity is linear in it).
-    """
+    `index` and `momentum` are one coordinate index and its momentum, or lists of them.
+    The momenta are linear in the cyclic velocities (possibly coupled, as for precession
+    and spin of a top): the velocities are solved from them, and the accelerations from
+    their time derivatives d/dt(dL/dv_c) = 0. Returns the equations of the remaining
+    coordinates, in their order."""
+    idx = [index] if isinstance(index, int) else list(index)
+    betas = [momentum] if isinstance(momentum, int) or not isinstance(momentum, (list, tuple)) else list(momentum)
     qs, vs, acc = _se_list(q), _se_list(qd), _se_list(qdd)
-    v, a = vs[index], acc[index]
-    pc = _se(L).diff(v)
-    k = pc.diff(v)
-    v_sol = v + (_se(momentum) - pc) / k  # exact: pc is linear in v
-    dpc = _time_derivative_se(pc, qs, vs, acc)
-    ka = dpc.diff(a)
-    a_sol = (a - dpc / ka).subs({v: v_sol})
+    Ls = _se(L)
+    cv = [vs[i] for i in idx]
+    ca = [acc[i] for i in idx]
+    pcs = [Ls.diff(v) for v in cv]
+    # momenta: p = Kv v_c + b, linear in the cyclic velocities
+    Kv = sp.Matrix([[_sp(pc.diff(v)) for v in cv] for pc in pcs])
+    b = sp.Matrix([_sp(pc.subs({v: 0 for v in cv})) for pc in pcs])
+    v_sol = Kv.LUsolve(sp.Matrix(betas) - b)
+    dpcs = [_time_derivative_se(pc, qs, vs, acc) for pc in pcs]
+    Ka = sp.Matrix([[_sp(d.diff(a)) for a in ca] for d in dpcs])
+    ba = sp.Matrix([_sp(d.subs({a: 0 for a in ca})) for d in dpcs])
+    a_sol = Ka.LUsolve(-ba)
+    vmap = {v: _se(s) for v, s in zip(cv, v_sol)}
+    amap = {a: _se(s).subs(vmap) for a, s in zip(ca, a_sol)}
     out = []
     for i, e in enumerate(equations):
-        if i == index:
+        if i in idx:
             continue
-        es = _se(e).subs({a: a_sol}).subs({v: v_sol})
-        out.append(_sp(es))
+        out.append(_sp(_se(e).subs(amap).subs(vmap)))
     return out
 
 

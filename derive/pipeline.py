@@ -140,12 +140,10 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
         op2 = mech.quadratic_expansion(R, rq, rqd, at=zero_set)
 
     with steps("linear operator, route 1: linearising the full equations with the integral"):
-        E_full = mech.lagrange_equations(L0, q, qd, qdd)
-        if len(model.cyclic) > 1:
-            raise NotImplementedError("route 1 eliminates one cyclic coordinate")
-        E = E_full
-        for cname, momentum in model.cyclic.items():
-            E = mech.eliminate_cyclic(E_full, q, qd, qdd, model.coordinates.index(cname), L0, momentum)
+        E = mech.lagrange_equations(L0, q, qd, qdd)
+        if model.cyclic:
+            E = mech.eliminate_cyclic(E, q, qd, qdd, [model.coordinates.index(c) for c in model.cyclic],
+                                      L0, list(model.cyclic.values()))
         names_after = [c for c in model.coordinates if c not in model.cyclic]
         E = [E[names_after.index(c)] for c in order]
         op1 = mech.linearize_equations(E, rq, rqd, rqdd, at=zero_set)
@@ -196,6 +194,12 @@ def functions(d: Derivation) -> list[Function]:
                         f"over q = ({', '.join(order)}); M, K symmetric, D skew."))
     fns.append(Function("operator_J", [params, qe, ("pval", [P_SYMBOL])], [("J", op.J(P_SYMBOL))],
                         "J(p) = M p^2 + D p + K of the exact operator at a real p."))
+    pr, pi = sp.symbols("p_re p_im")
+    fns.append(Function("operator_J_complex", [params, qe, ("pval", [pr, pi])],
+                        [("J_re", op.M * (pr**2 - pi**2) + op.D * pr + op.K),
+                         ("J_im", op.M * (2 * pr * pi) + op.D * pi)],
+                        "J(p) at a complex p = p_re + i p_im, as real and imaginary parts; "
+                        "J(i omega) at p = (0, omega)."))
     for vname, v in d.variants.items():
         fns.append(Function(f"{vname}_operator", [params],
                             [("M", v.operator.M), ("D", v.operator.D), ("K", v.operator.K)],

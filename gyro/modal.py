@@ -26,7 +26,11 @@ MAX_ANGLE_STEP = 0.2  # rad: Newton steps on angles are damped to stay on the br
 
 
 def _wrap(angle):
-    return (angle + np.pi) % (2 * np.pi) - np.pi
+    """Angles into (-pi, pi]; angles already there are returned untouched (adding and
+    subtracting pi would cost a small angle its relative precision)."""
+    angle = np.asarray(angle, dtype=float)
+    out = (angle + np.pi) % (2 * np.pi) - np.pi
+    return np.where(np.abs(angle) <= np.pi, angle, out)
 
 
 def equilibrium(model: Model, params: np.ndarray, tol: float = 1e-14, max_iter: int = 100) -> np.ndarray:

@@ -168,9 +168,16 @@ def test_generated_is_current_and_deterministic_across_hash_seeds(tmp_path):
             assert (out / MODEL / f.name).read_bytes() == f.read_bytes(), f"{f.name} differs"
 
 
-def test_generated_c_has_op_counts():
+def test_generated_op_counts_agree_with_metadata():
+    """Each C function states its operation count after CSE, the one metadata.json records."""
+    import re
+
+    meta = json.loads((GENERATED / MODEL / "metadata.json").read_text())["functions"]
     text = (GENERATED / MODEL / f"{MODEL}.c").read_text()
-    assert text.count("Total ops:") == text.count("\n{\n")
+    found = dict(re.findall(r"void " + MODEL + r"_(\w+)\(.*\n\{\n\s*// Total ops: (\d+)", text))
+    assert set(found) == set(meta)
+    for name, ops in found.items():
+        assert int(ops) == meta[name]["ops"] and meta[name]["ops"] < meta[name]["ops_before_cse"]
 
 
 def test_c_printer_parenthesises_powers_in_denominators():

@@ -111,3 +111,22 @@ def test_a_total_time_derivative_is_a_null_lagrangian():
     F = sp.sin(x) * y**2
     dL = mech.time_derivative(F, [x, y], [xd, yd]) + 7
     assert mech.null_lagrangian_residual(dL, [x, y], [xd, yd], sp.symbols("x_dd y_dd")) == [0, 0]
+
+
+def test_two_coupled_cyclic_coordinates_eliminated_together_equal_routh_twice():
+    """Heavy symmetric top: psi and phi are both cyclic, with coupled momenta
+    p_psi = A psi' sin^2 + C (phi' + psi' cos) cos, p_phi = C (phi' + psi' cos)."""
+    th, ps, ph = sp.symbols("theta psi phi")
+    thd, psd, phd = sp.symbols("theta_d psi_d phi_d")
+    thdd, psdd, phdd = sp.symbols("theta_dd psi_dd phi_dd")
+    A, C, P, l, a, b = sp.symbols("A C P l a b")
+    L = (A * (thd**2 + psd**2 * sp.sin(th)**2) / 2 + C * (phd + psd * sp.cos(th))**2 / 2
+         - P * l * sp.cos(th))
+    q, qd, qdd = [th, ps, ph], [thd, psd, phd], [thdd, psdd, phdd]
+    E = mech.lagrange_equations(L, q, qd, qdd)
+    (E2,) = mech.eliminate_cyclic(E, q, qd, qdd, [1, 2], L, [a, b])
+    R = mech.routhian(mech.routhian(L, phd, b), psd, a)
+    (ER,) = mech.lagrange_equations(R, [th], [thd], [thdd])
+    assert sp.simplify(E2 - ER) == 0
+    # the classical reduced equation: A theta'' = P l sin(th) + ... (no psi', phi' left)
+    assert not E2.has(psd) and not E2.has(phd)

@@ -16,8 +16,8 @@ MODEL = load("torsion_gyrocompass")
 
 @st.composite
 def parameter_sets(draw):
-    """Each parameter within 0.2x..5x the paper example (log-uniform); the latitude in
-    -85..85 deg; the casing inertias kept larger than what the geometry needs."""
+    """Each parameter within 0.2x..5x the paper example (log-uniform, independently); the
+    latitude in -85..85 deg."""
     values = {}
     for p in MODEL.params:
         if p.name == "phi":

@@ -339,8 +339,8 @@ def section3_formulas():
     put("omega5", wp, "(3.7): omega5 = omega_p")
     put("omega6", sp.sqrt(g / l * (1 - g / l * (m_c * l_c**2 / A * (a / W**2 + 1 / wy**2)
                                                  + m / (m_c * w0**2)))),
-        "(3.9), left side printed omega_0^2 read omega_6^2; error O(kappa6^2), "
-        "kappa6 = G l_c/(l K_gamma)")
+        "(3.9), left side printed omega_0^2 read omega_6^2; error O(delta6^2), delta6 "
+        "the relative size of its correction term (0.068 at the example)")
 
     def s8(b):  # (3.14)
         return omega_y2 * W**2 / (a * b * omega_y2 + W**2 * (b - 1))

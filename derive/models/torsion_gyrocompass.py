@@ -35,7 +35,7 @@ PARAMETERS = [
     Parameter("K0", "N/m", _m * 450.0**2, "axial bearing stiffness (omega_0 = 450 1/s)"),
     Parameter("Kp", "N/m", _m * 780.0**2, "radial bearing stiffness (omega_p = 780 1/s)"),
     Parameter("Kgamma", "N m/rad", _A * 560.0**2, "angular bearing stiffness (omega_y = 560 1/s)"),
-    Parameter("H", "kg m^2/s", _A * 3769.3, "rotor angular momentum H = A Omega", kind="nonnegative"),
+    Parameter("H", "kg m^2/s", 0.452316, "rotor angular momentum H = A Omega (Omega = 3769.3)", kind="nonnegative"),
     Parameter("u", "rad/s", 7.29e-5, "Earth rotation rate", kind="nonnegative"),
     Parameter("phi", "deg", 60.0, "latitude", kind="real", bounds=(-90.0, 90.0)),
     Parameter("g", "m/s^2", 9.81, "gravity along the plumb line", kind="nonnegative"),

@@ -375,3 +375,13 @@ def numeric_equilibrium(equations, unknowns, values: dict, guess: dict, dps: int
         sol = mp.findroot(lambda *x: f(*x), x0, J=lambda *x: jac(*x), tol=mp.mpf(10) ** (-dps + 5))
         sol = [sol] if len(unknowns) == 1 else list(sol)
     return dict(zip(unknowns, sol))
+
+
+def integral_rates(L, q, qd, qdd, integrals) -> list:
+    """Time derivatives of candidate first integrals along the Lagrange equations of L:
+    the accelerations are solved from the mass-matrix form (a small symbolic solve, for a
+    proof, never for emission). A first integral's rate simplifies to zero."""
+    Mq, f = mass_matrix_form(L, q, qd)
+    acc = Mq.LUsolve(f)
+    sub = dict(zip(qdd, acc))
+    return [time_derivative(I, q, qd, qdd).subs(sub) for I in integrals]

@@ -102,7 +102,7 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
             if bad:
                 raise AssertionError(f"identity failed: {name}: {bad[0]}")
 
-    with steps("Lagrange equations of all coordinates, mass-matrix form (1.13)"):
+    with steps("Lagrange equations of all coordinates, mass-matrix form"):
         Mq, f = mech.mass_matrix_form(L, q, qd)
         inputs = {}
         for fn, val, dval in zip(model.given_functions, model.given_values, model.given_derivatives):
@@ -177,10 +177,14 @@ def functions(d: Derivation) -> list[Function]:
     model = d.model
     params = ("params", model.symbols)
     qe = ("qe", d.even)
+    # the cyclic momenta that are not parameters (constants of a motion, e.g. H, L of a
+    # free gyroscope) are an input of everything that comes from the Routh function
+    moms = [s for s in model.cyclic.values() if s not in model.symbols]
+    state = [params, qe] + ([("momenta", moms)] if moms else [])
     order = model.reduced or [c for c in model.coordinates if c not in model.cyclic]
     even_names = [str(x) for x in d.even]
     fns = [
-        Function("equilibrium_residual", [params, qe], [("r", d.equilibrium_residual)],
+        Function("equilibrium_residual", state, [("r", d.equilibrium_residual)],
                  "Generalised forces dR/dq at rest on the symmetric set (R: Routh function); "
                  f"zero at a relative equilibrium. Rows: {', '.join(order)}."),
     ]
@@ -189,13 +193,13 @@ def functions(d: Derivation) -> list[Function]:
                             [("qe", sp.Matrix([model.equilibrium_approx[c] for c in even_names]))],
                             f"Approximate equilibrium (2.2) of {', '.join(even_names)}."))
     op = d.operator
-    fns.append(Function("operator", [params, qe], [("M", op.M), ("D", op.D), ("K", op.K)],
+    fns.append(Function("operator", state, [("M", op.M), ("D", op.D), ("K", op.K)],
                         "Exact linear operator about the equilibrium qe: M q'' + D q' + K q = 0 "
                         f"over q = ({', '.join(order)}); M, K symmetric, D skew."))
-    fns.append(Function("operator_J", [params, qe, ("pval", [P_SYMBOL])], [("J", op.J(P_SYMBOL))],
+    fns.append(Function("operator_J", state + [("pval", [P_SYMBOL])], [("J", op.J(P_SYMBOL))],
                         "J(p) = M p^2 + D p + K of the exact operator at a real p."))
     pr, pi = sp.symbols("p_re p_im")
-    fns.append(Function("operator_J_complex", [params, qe, ("pval", [pr, pi])],
+    fns.append(Function("operator_J_complex", state + [("pval", [pr, pi])],
                         [("J_re", op.M * (pr**2 - pi**2) + op.D * pr + op.K),
                          ("J_im", op.M * (2 * pr * pi) + op.D * pi)],
                         "J(p) at a complex p = p_re + i p_im, as real and imaginary parts; "
@@ -239,6 +243,7 @@ def metadata(d: Derivation) -> dict:
         "coordinates": model.coordinates,
         "coordinate_units": model.coordinate_units,
         "cyclic": {c: str(s) for c, s in model.cyclic.items()},
+        "momenta": [str(s) for s in model.cyclic.values() if s not in model.symbols],
         "reduced": order,
         "equilibrium_coordinates": [str(x) for x in d.even],
         "symmetric_zero": model.symmetric_zero,

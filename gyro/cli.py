@@ -40,6 +40,10 @@ def _frequencies(args) -> int:
     from gyro.modal import natural_frequencies
 
     model = load(args.model)
+    if model.meta.get("momenta"):
+        raise ParameterError(f"{model.name}: its operator depends on the momenta "
+                             f"{', '.join(model.meta['momenta'])} of a stationary motion; "
+                             "'frequencies' covers models with a relative equilibrium")
     values = model.parameters(_parse_sets(args.set))
     result = natural_frequencies(model, values)
     if not np.all(np.isfinite(result.frequencies + result.eigenvalues_re)):

@@ -15,25 +15,17 @@ MODEL = "torsion_gyrocompass"
 
 @pytest.fixture(scope="session")
 def tg_model():
-    from derive.models import torsion_gyrocompass as tg
-
-    return tg.build()
+    return derived(MODEL)[0]
 
 
 @pytest.fixture(scope="session")
-def tg_derivation(tg_model):
-    import io
-
-    from derive import pipeline
-
-    return pipeline.derive(tg_model, pipeline.Steps(out=io.StringIO()))
+def tg_derivation():
+    return derived(MODEL)[1]
 
 
 @pytest.fixture(scope="session")
-def tg_functions(tg_derivation):
-    from derive import pipeline
-
-    return {f.name: f for f in pipeline.functions(tg_derivation)}
+def tg_functions():
+    return derived(MODEL)[2]
 
 
 def compile_c(model: str, tmp: Path) -> ctypes.CDLL:
@@ -51,6 +43,19 @@ def compile_c(model: str, tmp: Path) -> ctypes.CDLL:
     return ctypes.CDLL(str(lib))
 
 
-@pytest.fixture(scope="session")
-def tg_clib(tmp_path_factory):
-    return compile_c(MODEL, tmp_path_factory.mktemp("clib"))
+_DERIVED = {}
+
+
+def derived(name: str):
+    """(model, derivation, functions by name) of any model, derived once per session."""
+    if name not in _DERIVED:
+        import importlib
+        import io
+
+        from derive import pipeline
+        from derive.models import MODELS
+
+        model = importlib.import_module(MODELS[name]).build()
+        d = pipeline.derive(model, pipeline.Steps(out=io.StringIO()))
+        _DERIVED[name] = (model, d, {f.name: f for f in pipeline.functions(d)})
+    return _DERIVED[name]

@@ -1,0 +1,117 @@
+"""Heavy gyroscope in a gimbal with a vertical outer axis (Avdonin, 1969).
+
+Source: shared/seeds/000_67a37024195e6e42.txt; equation numbers are the paper's.
+Euler angles psi (precession of the outer ring about the vertical xi3), theta (nutation:
+the casing's turn about its axis eta1 in the outer ring), phi (the rotor's spin about its
+symmetry axis eta3). Kinetic energy and force function as printed in section 1; the
+generic pipeline derives (1.1), reduces the two cyclic coordinates psi and phi with their
+momenta L and H, and emits the equations.
+
+The paper has no numerical example: the defaults below are an illustrative
+laboratory-sized gyroscope, not the paper's.
+"""
+from __future__ import annotations
+
+import sympy as sp
+
+from derive import mechanics as mech
+from derive.model import Parameter
+
+NAME = "gimbal_gyroscope"
+TITLE = "Heavy gyroscope in a gimbal with a vertical outer axis"
+SOURCE = "shared/seeds/000_67a37024195e6e42.txt (Avdonin 1969)"
+
+PARAMETERS = [
+    Parameter("A0", "kg m^2", 0.02, "A0 = C3 + B2 + A1: inertia about the vertical (illustrative)"),
+    Parameter("B0", "kg m^2", 0.015, "B0 = A1 + B1: inertia about the casing axis eta1 (illustrative)"),
+    Parameter("C0", "kg m^2", 0.0, "C0 = B2 + A1 - B3 (the closed form needs C0 = 0)", kind="real"),
+    Parameter("A3", "kg m^2", 0.01, "rotor polar moment of inertia (illustrative)"),
+    Parameter("P1", "N", 5.0, "weight of the casing (illustrative)", kind="nonnegative"),
+    Parameter("eta20", "m", 0.002, "casing mass centre along eta2 (illustrative)", kind="real"),
+    Parameter("eta30", "m", 0.01, "casing mass centre along eta3 (illustrative)", kind="real"),
+    Parameter("P", "N", 10.0, "weight of the rotor (illustrative)", kind="nonnegative"),
+    Parameter("l", "m", 0.02, "rotor mass centre along the symmetry axis eta3 (illustrative)", kind="real"),
+]
+Pm = {p.name: p.symbol for p in PARAMETERS}
+A0, B0, C0, A3, P1, eta20, eta30, P, l = (Pm[p.name] for p in PARAMETERS)
+G = P1 * eta30 + P * l  # (1.1)
+
+COORDINATES = ["psi", "theta", "phi"]
+COORDINATE_UNITS = {c: "rad" for c in COORDINATES}
+q = sp.symbols(COORDINATES)
+qd = sp.symbols([c + "_d" for c in COORDINATES])
+qdd = sp.symbols([c + "_dd" for c in COORDINATES])
+psi, theta, phi = q
+psid, thetad, phid = qd
+
+# the momenta of the cyclic coordinates, constants of the motion (1.2)
+H, L = sp.symbols("H L")
+
+
+def kinetic_energy():
+    """2T of section 1, with C0 general (the paper then sets C0 = 0)."""
+    return (psid**2 * (A0 - C0 * sp.cos(theta)**2) + thetad**2 * B0
+            + A3 * (phid + psid * sp.cos(theta))**2) / 2
+
+
+def force_function():
+    """U = -P1 eta20 sin(theta) - (P1 eta30 + P l) cos(theta)."""
+    return -P1 * eta20 * sp.sin(theta) - G * sp.cos(theta)
+
+
+def lagrangian():
+    return kinetic_energy() + force_function()
+
+
+def printed_equations():
+    """(1.1) as printed (C0 = 0), each as 'left - right', in the order psi, theta, phi."""
+    w = phid + psid * sp.cos(theta)
+    return [
+        mech.time_derivative(A0 * psid + A3 * sp.cos(theta) * w, q, qd, qdd),
+        B0 * sp.Symbol("theta_dd") + A3 * psid * sp.sin(theta) * w
+        - (-P1 * eta20 * sp.cos(theta) + G * sp.sin(theta)),
+        A3 * mech.time_derivative(w, q, qd, qdd),
+    ]
+
+
+def printed_integrals():
+    """(1.2) as printed (C0 = 0): H, L, M."""
+    w = phid + psid * sp.cos(theta)
+    return {
+        "H": A3 * w,
+        "L": A0 * psid + A3 * w * sp.cos(theta),
+        "M": A0 * psid**2 + B0 * thetad**2 + 2 * P1 * eta20 * sp.sin(theta) + 2 * G * sp.cos(theta),
+    }
+
+
+def integrals():
+    """First integrals for general C0: the cyclic momenta and the energy T - U."""
+    Lg = lagrangian()
+    return {
+        "H": mech.cyclic_integral(Lg, phid),
+        "L": mech.cyclic_integral(Lg, psid),
+        "E": kinetic_energy() - force_function(),
+    }
+
+
+def integrals_are_conserved():
+    """d/dt of each first integral along the equations of motion (accelerations from the
+    mass-matrix form): all zero for general C0, and for the printed (1.2) at C0 = 0."""
+    out = mech.integral_rates(lagrangian(), q, qd, qdd, list(integrals().values()))
+    out += [r.subs(C0, 0) for r in
+            mech.integral_rates(lagrangian().subs(C0, 0), q, qd, qdd, list(printed_integrals().values()))]
+    return [sp.simplify(r) for r in out]
+
+
+def build():
+    from derive.model import Model
+
+    return Model(
+        name=NAME, title=TITLE, source=SOURCE, module=__name__,
+        parameters=PARAMETERS, coordinates=COORDINATES, coordinate_units=COORDINATE_UNITS,
+        q=list(q), qd=list(qd), qdd=list(qdd),
+        lagrangian=lagrangian(),
+        cyclic={"phi": H, "psi": L},
+        reduced=["theta"],
+        identities={"first integrals (1.2): H, L and the energy are conserved": integrals_are_conserved},
+    )

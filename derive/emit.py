@@ -110,6 +110,7 @@ class Output:
     rows: int
     cols: int
     entries: list  # (flat index, printed expression) for non-zero entries, row-major
+    vector: bool = False  # a column that NumPy returns with shape batch + (rows,)
 
 
 @dataclass
@@ -158,7 +159,8 @@ def _printed(fn, temps, reduced, ops, ops_before, printer) -> EmittedFunction:
             e = reduced[k + idx]
             if e != 0:
                 entries.append((idx, printer.doprint(e)))
-        outs.append(Output(name, mat.rows, mat.cols, entries))
+        outs.append(Output(name, mat.rows, mat.cols, entries,
+                           vector=mat.cols == 1 and name not in fn.matrices))
         k += mat.rows * mat.cols
     return EmittedFunction(
         name=fn.name, doc=fn.doc,

@@ -54,6 +54,9 @@ class Function:
     inputs: list[tuple[str, list]]
     outputs: list[tuple[str, sp.Matrix]]
     doc: str
+    # outputs that are matrices even when 1x1 (an operator of one coordinate); any other
+    # one-column output is a vector
+    matrices: tuple = ()
 
 
 @dataclass

@@ -18,6 +18,7 @@ from derive import mechanics as mech
 from derive.model import Function, Model
 
 P_SYMBOL = sp.Symbol("p")  # the operator d/dt
+MATRICES = ("M", "D", "K", "J", "J_re", "J_im", "Mq")  # outputs that stay matrices when 1x1
 Z_SYMBOL = sp.Symbol("z")  # p^2
 
 
@@ -195,20 +196,20 @@ def functions(d: Derivation) -> list[Function]:
     op = d.operator
     fns.append(Function("operator", state, [("M", op.M), ("D", op.D), ("K", op.K)],
                         "Exact linear operator about the equilibrium qe: M q'' + D q' + K q = 0 "
-                        f"over q = ({', '.join(order)}); M, K symmetric, D skew."))
+                        f"over q = ({', '.join(order)}); M, K symmetric, D skew.", MATRICES))
     fns.append(Function("operator_J", state + [("pval", [P_SYMBOL])], [("J", op.J(P_SYMBOL))],
-                        "J(p) = M p^2 + D p + K of the exact operator at a real p."))
+                        "J(p) = M p^2 + D p + K of the exact operator at a real p.", MATRICES))
     pr, pi = sp.symbols("p_re p_im")
     fns.append(Function("operator_J_complex", state + [("pval", [pr, pi])],
                         [("J_re", op.M * (pr**2 - pi**2) + op.D * pr + op.K),
                          ("J_im", op.M * (2 * pr * pi) + op.D * pi)],
                         "J(p) at a complex p = p_re + i p_im, as real and imaginary parts; "
-                        "J(i omega) at p = (0, omega)."))
+                        "J(i omega) at p = (0, omega).", MATRICES))
     for vname, v in d.variants.items():
         fns.append(Function(f"{vname}_operator", [params],
                             [("M", v.operator.M), ("D", v.operator.D), ("K", v.operator.K)],
                             f"Operator of the '{vname}' variant ({model.variants[vname].doc}); "
-                            "rows not scaled."))
+                            "rows not scaled.", MATRICES))
         fns.append(Function(f"{vname}_charpoly", [params],
                             [(f"block{i + 1}", sp.Matrix(c)) for i, c in enumerate(v.charpoly)],
                             f"Characteristic polynomial of each diagonal block of the '{vname}' "
@@ -219,12 +220,12 @@ def functions(d: Derivation) -> list[Function]:
                             "The paper's approximate formulas, in the order of metadata "
                             "'formulas'."))
     fns.append(Function("mass_matrix", [params, ("q", model.q)], [("Mq", d.mass_matrix)],
-                        "Mass matrix of the full nonlinear equations (1.13): Mq qdd = f."))
+                        "Mass matrix of the full nonlinear equations: Mq qdd = f.", MATRICES))
     given = [("given", model.given_values), ("dgiven", model.given_derivatives),
              ("constants", model.given_constants)] if model.given_values else []
     fns.append(Function("forcing", [params, ("q", model.q), ("qd", model.qd)] + given,
                         [("f", d.forcing)],
-                        "Right-hand side f(q, qd) of the full nonlinear equations (1.13), "
+                        "Right-hand side f(q, qd) of the full nonlinear equations, "
                         "Mq qdd = f, with the given functions' values and derivatives as inputs."))
     return fns
 

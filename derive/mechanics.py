@@ -189,7 +189,7 @@ def eliminate_cyclic(equations, q, qd, qdd, index, L, momentum):
     their time derivatives d/dt(dL/dv_c) = 0. Returns the equations of the remaining
     coordinates, in their order."""
     idx = [index] if isinstance(index, int) else list(index)
-    betas = [momentum] if isinstance(momentum, int) or not isinstance(momentum, (list, tuple)) else list(momentum)
+    betas = list(momentum) if isinstance(momentum, (list, tuple)) else [momentum]
     qs, vs, acc = _se_list(q), _se_list(qd), _se_list(qdd)
     Ls = _se(L)
     cv = [vs[i] for i in idx]

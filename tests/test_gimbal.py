@@ -132,8 +132,8 @@ DEFAULTS = {"A0": 0.02, "B0": 0.015, "C0": 0.0, "A3": 0.01, "P1": 5.0, "eta20": 
 @pytest.mark.parametrize("theta0, H", [(1.2, 2.0), (1.2, 0.05), (2.4, 2.0), (0.3, 0.5)])
 def test_stationary_motion_3_1_and_the_delta_form_of_3_3(theta0, H):
     """At psi0' from (3.1) the emitted equilibrium equation vanishes, and the emitted U1''
-    equals the Delta form +-sqrt(Delta) - H^2 P1^2 eta20^2/(A0 Delta), the sign that of
-    cos(theta0) (G - H psi0')... i.e. of P1 eta20 sin(theta0) + (G - H psi0') cos(theta0)."""
+    equals the Delta form +-sqrt(Delta) - H^2 P1^2 eta20^2/(A0 Delta), with the sign of
+    P1 eta20 sin(theta0) + (G - H psi0') cos(theta0)."""
     v = DEFAULTS
     psi0d, _, G = _stationary(v, theta0, H)
     U1pp, r = _U1pp(v, theta0, H)

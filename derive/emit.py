@@ -145,11 +145,6 @@ def _cse(fn: Function):
     return temps, reduced, ops, ops_before
 
 
-def cse_function(fn: Function, printer) -> EmittedFunction:
-    temps, reduced, ops, ops_before = _cse(fn)
-    return _printed(fn, temps, reduced, ops, ops_before, printer)
-
-
 def _printed(fn, temps, reduced, ops, ops_before, printer) -> EmittedFunction:
     outs, k = [], 0
     for name, mat in fn.outputs:

@@ -233,10 +233,6 @@ class LinearOperator:
     def subs(self, mapping) -> "LinearOperator":
         return self.applyfunc(lambda e: e.subs(mapping))
 
-    def permuted(self, order: Sequence[int]) -> "LinearOperator":
-        P = list(order)
-        return LinearOperator(self.M.extract(P, P), self.D.extract(P, P), self.K.extract(P, P))
-
 
 def _at(e, at):
     return e if not at else e.subs(at)

@@ -102,3 +102,14 @@ def test_an_instability_is_reported_not_hidden():
     growth = max(out["eigenvalues_re"])
     u = out["params"]["u"]
     assert 0.01 * u < growth < 10 * u  # 1.1e-5 = 0.15 u
+
+
+def test_modal_result_saves_and_loads_itself(tmp_path):
+    from gyro import load
+    from gyro.modal import ModalResult, natural_frequencies
+
+    m = load("torsion_gyrocompass")
+    r = natural_frequencies(m, m.parameters({"phi": 45.0}))
+    r.save(tmp_path / "modes.json")
+    back = ModalResult.load(tmp_path / "modes.json")
+    assert back == r and back.frequencies[1] == r.frequencies[1] and back.params["phi"] == 45.0

@@ -1,10 +1,11 @@
 """Emission: one symbolic result -> CasADi, NumPy and C code through jinja2 templates.
 
 For each `Function` of a model, the expressions of all its outputs go through one
-common-subexpression elimination; the same CSE is printed three ways:
+common-subexpression elimination; the same CSE is printed four ways:
 - `casadi_functions.py`: CasADi `Function` objects (SX graphs built at import);
 - `numpy_functions.py`: vectorised NumPy functions over a leading batch of parameter sets;
-- `<model>.h`, `<model>.c`: flat, allocation-free C99.
+- `mpmath_functions.py`: the same in arbitrary precision (references for tests and charts);
+- `<model>.h`, `<model>.c`: flat, allocation-free C99, each function also over a batch.
 Every file starts with a header naming the template it came from, saying it must not be
 edited, and carrying a hash of the inputs that made it (the sources of `derive/`, the
 templates and the pinned SymPy, SymEngine and CasADi versions). Bytes are deterministic:
@@ -22,7 +23,7 @@ import jinja2
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.numpy import NumPyPrinter
-from sympy.printing.pycode import PythonCodePrinter
+from sympy.printing.pycode import MpmathPrinter, PythonCodePrinter
 
 from derive.model import Function
 
@@ -68,6 +69,20 @@ class NumpyPrinter(NumPyPrinter):
 
     def _print_Rational(self, expr):
         return f"({expr.p}/{expr.q})"
+
+
+class MpPrinter(MpmathPrinter):
+    """mpmath with exact constants: rationals as mpf quotients, pi at working precision."""
+
+    def _print_Rational(self, expr):
+        return f"(mpmath.mpf({expr.p})/{expr.q})"
+
+    def _print_Pow(self, expr, rational=False):
+        if expr.exp == sp.Rational(1, 2):
+            return f"mpmath.sqrt({self._print(expr.base)})"
+        if expr.exp == -sp.Rational(1, 2):
+            return f"(1/mpmath.sqrt({self._print(expr.base)}))"
+        return super()._print_Pow(expr, rational=rational)
 
 
 class CasadiPrinter(PythonCodePrinter):
@@ -200,7 +215,8 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
     module_file = Path(importlib.import_module(model.module).__file__)
     digest = input_hash(module_file)
     env = environment()
-    printers = {"c": CPrinter(), "numpy": NumpyPrinter(), "casadi": CasadiPrinter()}
+    printers = {"c": CPrinter(), "numpy": NumpyPrinter(), "casadi": CasadiPrinter(),
+                "mpmath": MpPrinter()}
     emitted = {k: [] for k in printers}
     for fn in functions:
         temps, reduced, ops, ops_before = _cse(fn)
@@ -212,6 +228,7 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
     files = {
         "casadi_functions.py": ("casadi_functions.py.j2", emitted["casadi"]),
         "numpy_functions.py": ("numpy_functions.py.j2", emitted["numpy"]),
+        "mpmath_functions.py": ("mpmath_functions.py.j2", emitted["mpmath"]),
         f"{model.name}.h": ("model.h.j2", emitted["c"]),
         f"{model.name}.c": ("model.c.j2", emitted["c"]),
         "__init__.py": ("package_init.py.j2", emitted["numpy"]),

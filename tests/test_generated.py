@@ -115,6 +115,29 @@ def _call_casadi(fn, vals, model=MODEL):
     return [np.array(r.full()) for r in res]
 
 
+def _call_mpmath(fn, vals, model=MODEL):
+    """The mpmath backend at 30 digits, rounded to double (compared like the others)."""
+    import importlib
+
+    import mpmath
+
+    mf = importlib.import_module(f"generated.{model}.mpmath_functions")
+    args = [[vals[s] for s in syms] for _, syms in fn.inputs]
+    with mpmath.workdps(30):
+        res = getattr(mf, fn.name)(*args)
+    res = list(res) if isinstance(res, tuple) else [res]
+    return [np.array(r.tolist(), dtype=float) for r in res]
+
+
+def _call_c_batch(lib, fn, points, model=MODEL):
+    """The `_batch` entry point over several points at once, packed set after set."""
+    ptr = ctypes.POINTER(ctypes.c_double)
+    ins = [np.array([[v[s] for s in syms] for v in points]) for _, syms in fn.inputs]
+    outs = [np.zeros((len(points), mat.rows * mat.cols)) for _, mat in fn.outputs]
+    getattr(lib, f"{model}_{fn.name}_batch")(ctypes.c_long(len(points)), *[a.ctypes.data_as(ptr) for a in ins + outs])
+    return [[o[k].reshape(mat.rows, mat.cols) for o, (_, mat) in zip(outs, fn.outputs)] for k in range(len(points))]
+
+
 def _compare(got, ref, what):
     """Each entry's error relative to its term scale (its value when nothing cancels)."""
     worst = 0.0
@@ -128,21 +151,29 @@ def _compare(got, ref, what):
 
 @pytest.mark.parametrize("name", MODELS)
 def test_generated_code_matches_symbolic(name, tmp_path):
-    """C (compiled with -Wall -Wextra -Werror), NumPy and CasADi at 100 random points of
-    every emitted function of every model, each entry to 1e-12 of its term scale."""
+    """C (compiled with -Wall -Wextra -Werror), NumPy, CasADi and mpmath at 100 random
+    points of every emitted function of every model, each entry to 1e-12 of its term scale;
+    the C batch entry point over the same points gives the same bytes as the single calls."""
     model, _, functions = derived(name)
     lib = compile_c(name, tmp_path)
     rng = random.Random(2024)
     for fname, fn in functions.items():
         shapes = [(mat.rows, mat.cols) for _, mat in fn.outputs]
+        points, singles = [], []
         for k in range(N_POINTS):
             vals = _random_inputs(fn, model, rng)
             ref = _reference(fn, vals)
-            _compare(_call_c(lib, fn, vals, name), ref, f"C {name}.{fname}")
+            points.append(vals)
+            singles.append(_call_c(lib, fn, vals, name))
+            _compare(singles[-1], ref, f"C {name}.{fname}")
             if k % 5 == 0:  # the Python backends share the printer logic: every 5th point
-                for backend, call in (("numpy", _call_numpy), ("casadi", _call_casadi)):
+                for backend, call in (("numpy", _call_numpy), ("casadi", _call_casadi),
+                                      ("mpmath", _call_mpmath)):
                     got = [np.asarray(g, dtype=float).reshape(s) for g, s in zip(call(fn, vals, name), shapes)]
                     _compare(got, ref, f"{backend} {name}.{fname}")
+        for one, many in zip(singles, _call_c_batch(lib, fn, points, name)):
+            for a, b in zip(one, many):
+                np.testing.assert_array_equal(a, b)
 
 
 def test_numpy_functions_broadcast_over_a_batch(tg_model):

@@ -103,6 +103,10 @@ class Model:
     variants: dict = field(default_factory=dict)  # name -> Variant
     formulas: dict = field(default_factory=dict)  # name -> SymPy expression in parameters
     formula_docs: dict = field(default_factory=dict)  # name -> equation number and reading
+    # approximate natural frequencies, one entry per mode: (label, [(formula name, relative
+    # error estimate as an expression in the parameters), ...]); the runtime takes, per
+    # parameter set and mode, the candidate whose own estimate is smallest
+    mode_formulas: list = field(default_factory=list)
 
     def param(self, name: str) -> Parameter:
         for p in self.parameters:

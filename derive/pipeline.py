@@ -219,6 +219,15 @@ def functions(d: Derivation) -> list[Function]:
                             [("values", sp.Matrix(list(model.formulas.values())))],
                             "The paper's approximate formulas, in the order of metadata "
                             "'formulas'."))
+    if model.mode_formulas:
+        width = max(len(c) for _, c in model.mode_formulas)
+        rows = [c + [c[-1]] * (width - len(c)) for _, c in model.mode_formulas]  # pad: repeat
+        fns.append(Function("mode_formulas", [params],
+                            [("omega", sp.Matrix([[model.formulas[n] for n, _ in r] for r in rows])),
+                             ("estimate", sp.Matrix([[e for _, e in r] for r in rows]))],
+                            "Approximate natural frequencies, a row per mode (metadata "
+                            "'mode_formulas'), a column per candidate formula, with each "
+                            "candidate's relative error estimate.", MATRICES))
     fns.append(Function("mass_matrix", [params, ("q", model.q)], [("Mq", d.mass_matrix)],
                         "Mass matrix of the full nonlinear equations: Mq qdd = f.", MATRICES))
     given = [("given", model.given_values), ("dgiven", model.given_derivatives),
@@ -252,5 +261,6 @@ def metadata(d: Derivation) -> dict:
         "variants": {name: {"blocks": [[order[i] for i in b] for b in v.blocks]}
                      for name, v in d.variants.items()},
         "formulas": [{"name": k, "doc": model.formula_docs.get(k, "")} for k in model.formulas],
+        "mode_formulas": [{"mode": label, "candidates": [n for n, _ in c]} for label, c in model.mode_formulas],
         "route_agreement": d.route_agreement,
     }

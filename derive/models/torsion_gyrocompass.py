@@ -375,6 +375,12 @@ def section3_formulas():
     put("omega_rigid", W / sp.sqrt(a * b1),
         "after (3.28): lim omega_*8(b') as K_gamma -> oo, Omega/sqrt(a b') (printed "
         "Omega/sqrt(I1 b^2), read as such)")
+    # small parameters of the estimates of the ladder's `formulas` rung (docs/methods.md)
+    put("kappa6", G * l_c / (l * Kgamma),
+        "kappa6 = G l_c/(l K_gamma): the pendulum's load on the rotor's angular spring, the "
+        "first-order gravity shift of the nutation roots that the g = 0 quartic (3.10) omits")
+    put("delta6", g / l * (m_c * l_c**2 / A * (a / W**2 + 1 / wy**2) + m / (m_c * w0**2)),
+        "delta6: the relative size of the correction term of (3.9)")
     # the quartic (3.10) K0 L(z, b') - z m_* L(z, b'') = 0, coefficients lowest first
     zs = sp.Symbol("z")
     quartic = sp.Poly(sp.expand(K0 * L_poly(zs, b1) - zs * m_s * L_poly(zs, b2)), zs)
@@ -384,6 +390,34 @@ def section3_formulas():
 
 
 # ----------------------------------------------------------------------------- the model
+
+
+def mode_formulas(F):
+    """The ten modes by formulas, each with the relative error estimate of what it neglects.
+
+    The small parameter and its order come from the derivation and the scaling tests
+    (docs/frequencies.md): eps2^2 for (3.4), eps2 for (3.5)-(3.7) (their u-coupling is not
+    of second order), delta6^2 for (3.9), mu1 + kappa6 for (3.26) (first order in mu1, plus
+    the gravity shift the quartic omits), k^2 + kappa6 for the small-k variant (3.28). For
+    (3.2) corrected it is omega1/omega_y (the next-order coupling with the rotor's angular
+    spring). Constants are 1 except 3 for (3.28); each is checked against the exact spectrum
+    over the spreads of `make bench` and on random sets (tests/test_ladder.py). The two
+    nutation families are candidates of the same four modes: per set, the one whose
+    estimate is smaller applies (3.26 when k is large, 3.28 when it is small)."""
+    eps2, mu1, k, kappa6, delta6 = F["eps2"], F["mu1"], F["k"], F["kappa6"], F["delta6"]
+    big, small = mu1 + kappa6, 3 * (k**2 + kappa6)
+    return [
+        ("omega1", [("omega1_eq", F["omega1_eq"] / F["omega_y"])]),
+        ("omega2", [("omega2_eq", eps2**2)]),
+        ("omega3", [("omega3_eq", eps2)]),
+        ("omega4", [("omega4_eq", eps2)]),
+        ("omega5", [("omega5", eps2)]),
+        ("omega6", [("omega6", delta6**2)]),
+        ("nutation a", [("omega7", big), ("omega7_smallk", small)]),
+        ("nutation b", [("omega8", big), ("omega8_smallk", small)]),
+        ("nutation c", [("omega9", big), ("omega9_smallk", small)]),
+        ("nutation d", [("omega10", big), ("omega10_smallk", small)]),
+    ]
 
 
 def build():
@@ -410,5 +444,5 @@ def build():
             printed=printed_operator, corrections=print_corrections,
             doc="the paper's printed operator (2.4): linearised at q = 0, u3 dropped, u^2 "
                 "dropped, A u and I_i u neglected against H")},
-        formulas=formulas, formula_docs=docs,
+        formulas=formulas, formula_docs=docs, mode_formulas=mode_formulas(formulas),
     )

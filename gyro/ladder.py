@@ -1,0 +1,499 @@
+"""Natural frequencies by a ladder of methods, vectorised over a batch of parameter sets.
+
+Every method returns, for each parameter set, the ten frequencies in ascending order with
+a relative error estimate for each (docs/methods.md):
+
+- ``formulas``: the paper's approximate formulas (3.2)-(3.28), corrected where the derivation
+  shows them wrong, emitted by `make derive` and run as compiled C over the batch. The
+  estimate is the size of what each formula neglects (its small parameter to its order).
+- ``polyroots``: roots of the characteristic polynomial det J(p), a polynomial of degree
+  n in s = p^2 whose coefficients are fitted in double precision (the naive baseline).
+  The estimate is the root's sensitivity to the coefficients' rounding.
+- ``companion``: eigenvalues of the balanced first-order (companion) matrix by LAPACK.
+  The estimate is eps ||A|| / |lambda| (Bauer-Fike for a well-conditioned root).
+- ``default``: scaled and structure-aware. Per diagonal block of the operator, the
+  gyroscopic problem with K > 0 is the Hermitian pencil diag(K, M) z = omega B z with
+  B = [[-iD, M], [M, 0]]; after a diagonal scaling and Cholesky factors it is one small
+  Hermitian eigenproblem (LAPACK), whose eigenvalues 1/omega are real. Each root is then
+  refined on the full exact operator, where the blocks are coupled weakly: one step of
+  inverse iteration on J(i omega) and the Rayleigh functional z* J(i omega) z = 0 (a
+  quadratic in omega). Its estimate is a residual bound plus the rounding floor of
+  evaluating J. Sets where a block's K is not positive definite, roots leave the real
+  axis, two roots merge, or the estimate exceeds the tolerance, escalate by themselves:
+  first to the general companion solver with Newton refinement, then to ``reference``.
+- ``reference``: equilibrium, operator and eigenvalues in arbitrary precision (mpmath, 40
+  digits), each root polished by Newton on det J in the same precision; the estimate is
+  the size of the last Newton step.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import mpmath
+import numpy as np
+
+from gyro import modal
+from gyro.models import Model
+
+METHODS = ("formulas", "polyroots", "companion", "default", "reference")
+DEFAULT_TOL = 1e-10
+EPS = np.finfo(float).eps
+REFERENCE_DPS = 40
+FORMULA_CHUNK = 8192
+
+
+@dataclass
+class Spectrum:
+    """The result of one method over a batch: arrays of shape (sets, modes)."""
+
+    method: str
+    frequencies: np.ndarray  # rad/s, ascending per set
+    growth: np.ndarray  # real parts of the eigenvalues (> 0: growing), same order
+    error_estimate: np.ndarray  # relative error bound per frequency
+    equilibrium: np.ndarray | None = None  # (sets, equilibrium coordinates)
+    route: np.ndarray = field(default=None)  # per set: which rung answered (default only)
+    seconds: float = 0.0  # wall time of the call
+
+    def __len__(self):
+        return self.frequencies.shape[0]
+
+
+# --------------------------------------------------------------------------- batch helpers
+
+
+def _fn(model: Model, name: str):
+    """A generated function over a batch: compiled C when a compiler is there, NumPy otherwise."""
+    from gyro.cbackend import CompilerUnavailable, batch_function
+
+    try:
+        f = batch_function(model.name, name)
+    except CompilerUnavailable:
+        g = getattr(model.numpy, name)
+
+        def f(*args):
+            out = g(*args)
+            return list(out) if isinstance(out, tuple) else [out]
+    return f
+
+
+def as_batch(model: Model, params) -> np.ndarray:
+    P = np.asarray(params, dtype=float)
+    if P.ndim == 1:
+        P = P[None, :]
+    if P.ndim != 2 or P.shape[1] != len(model.param_names):
+        raise ValueError(f"params: expected shape (sets, {len(model.param_names)}), got {P.shape}")
+    return P
+
+
+def equilibria(model: Model, P: np.ndarray, tol: float = 1e-14, max_iter: int = 40):
+    """Relative equilibria of a batch by Newton's method from (2.2), vectorised; the damping
+    and the branch are those of gyro.modal.equilibrium. Returns (qe, ok)."""
+    reduced = model.meta["reduced"]
+    names = model.meta["equilibrium_coordinates"]
+    idx = np.array([reduced.index(c) for c in names])
+    units = model.meta.get("coordinate_units", {})
+    is_angle = np.array([units.get(c) == "rad" for c in names])
+    n = P.shape[0]
+    if "equilibrium_approx" in model.meta["functions"]:
+        with np.errstate(all="ignore"):
+            qe = _fn(model, "equilibrium_approx")(P)[0].reshape(n, -1)
+        qe = np.where(np.isfinite(qe), qe, 0.0)
+    else:
+        qe = np.zeros((n, len(names)))
+    active = np.ones(n, bool)
+    resid, oper = _fn(model, "equilibrium_residual"), _fn(model, "operator")
+    for _ in range(max_iter):
+        a = np.flatnonzero(active)
+        if a.size == 0:
+            break
+        with np.errstate(all="ignore"):
+            r = resid(P[a], qe[a])[0].reshape(a.size, -1)[:, idx]
+            K = oper(P[a], qe[a])[2][:, idx][:, :, idx]
+            try:
+                dq = np.linalg.solve(K, r[..., None])[..., 0]
+            except np.linalg.LinAlgError:
+                dq = np.array([np.linalg.lstsq(k, v, rcond=None)[0] for k, v in zip(K, r)])
+        big = np.max(np.abs(np.where(is_angle, dq, 0.0)), axis=1)
+        dq *= np.minimum(1.0, modal.MAX_ANGLE_STEP / np.maximum(big, 1e-300))[:, None]
+        qe[a] += dq
+        bad = ~np.all(np.isfinite(qe[a]), axis=1)
+        conv = np.all(np.abs(dq) <= tol * np.maximum(np.abs(qe[a]), 1e-300) + 1e-300, axis=1)
+        active[a[conv | bad]] = False
+        qe[a[bad]] = np.nan
+    ok = np.all(np.isfinite(qe), axis=1) & ~active
+    qe = np.where(is_angle, modal._wrap(qe), qe)
+    return qe, ok
+
+
+def operators(model: Model, P: np.ndarray, qe: np.ndarray):
+    with np.errstate(all="ignore"):
+        return _fn(model, "operator")(P, qe)
+
+
+def _blocks(model: Model) -> list[np.ndarray]:
+    """Index sets of the operator's diagonal blocks (coupled weakly in the exact operator)."""
+    reduced = model.meta["reduced"]
+    for v in model.meta.get("variants", {}).values():
+        if v.get("blocks"):
+            return [np.array([reduced.index(c) for c in b]) for b in v["blocks"]]
+    return [np.arange(len(reduced))]
+
+
+def _sorted(freq, growth, est):
+    order = np.argsort(freq, axis=1)
+    take = lambda a: np.take_along_axis(a, order, axis=1)  # noqa: E731
+    return take(freq), take(growth), take(est)
+
+
+# --------------------------------------------------------------------------- companion
+
+
+def _companion_matrices(M, D, K):
+    n = M.shape[-1]
+    MinvK = np.linalg.solve(M, K)
+    MinvD = np.linalg.solve(M, D)
+    N = M.shape[0]
+    A = np.zeros((N, 2 * n, 2 * n))
+    A[:, :n, n:] = np.eye(n)
+    A[:, n:, :n] = -MinvK
+    A[:, n:, n:] = -MinvD
+    return A
+
+
+def _pairs(lams: np.ndarray, n: int) -> np.ndarray:
+    """One eigenvalue per pair, for each set (gyro.modal.representatives, batched)."""
+    return np.array([modal.representatives(l, n) for l in lams])
+
+
+def companion(model: Model, P: np.ndarray) -> Spectrum:
+    qe, ok = equilibria(model, P)
+    M, D, K = operators(model, P, qe)
+    n = M.shape[-1]
+    A = _companion_matrices(M, D, K)
+    good = ok & np.all(np.isfinite(A), axis=(1, 2))
+    lam = np.full((P.shape[0], n), np.nan + 0j)
+    if good.any():
+        lam[good] = _pairs(np.linalg.eigvals(A[good]), n)
+    # LAPACK balances A (D A D^-1) before its backward-stable QR iteration
+    norm = np.linalg.norm(A, ord=1, axis=(1, 2))
+    est = 2 * n * EPS * norm[:, None] / np.abs(lam)
+    f, g, e = _sorted(np.abs(lam.imag), lam.real, est)
+    return Spectrum("companion", f, g, e, qe)
+
+
+# --------------------------------------------------------------------------- polynomial
+
+
+def polyroots(model: Model, P: np.ndarray) -> Spectrum:
+    """det J(p) = c(s), s = p^2, degree n, is fitted from n + 1 Chebyshev points of s in
+    [-R, 0] (R bounds omega_max^2 by Gershgorin on M^-1 K) in double precision, converted
+    to the power basis and solved by numpy.roots: the textbook route."""
+    qe, ok = equilibria(model, P)
+    M, D, K = operators(model, P, qe)
+    N, n = P.shape[0], M.shape[-1]
+    freq = np.full((N, n), np.nan)
+    growth = np.full((N, n), np.nan)
+    est = np.full((N, n), np.inf)
+    with np.errstate(all="ignore"):
+        R = 1.5 * np.max(np.sum(np.abs(np.linalg.solve(M, K)), axis=2), axis=1)
+        t = np.cos(np.pi * (np.arange(n + 1) + 0.5) / (n + 1))  # Chebyshev nodes in [-1, 1]
+        s = -R[:, None] * (1 + t[None, :]) / 2  # in [-R, 0]
+        p = np.sqrt(s.astype(complex))
+        J = (M[:, None] * s[..., None, None] + D[:, None] * p[..., None, None] + K[:, None])
+        dets = np.linalg.det(J).real  # J(i w) is Hermitian: det is real
+    for k in np.flatnonzero(ok & np.all(np.isfinite(dets), axis=1)):
+        # in x = 2 s / R + 1 the nodes are t; the power basis in s follows by substitution
+        cheb = np.polynomial.chebyshev.chebfit(t, dets[k], n)
+        poly_x = np.polynomial.chebyshev.cheb2poly(cheb)
+        poly_s = np.polynomial.polynomial.Polynomial(poly_x)(np.polynomial.polynomial.Polynomial([-1.0, -2.0 / R[k]]))
+        c = poly_s.coef
+        roots_s = np.roots(c[::-1])
+        lam = np.sqrt(roots_s.astype(complex))  # p = sqrt(s), the upper member
+        lam = np.where(lam.imag < 0, -lam, lam)
+        if len(lam) != n:
+            continue
+        # the fit errs by about eps max|det| at every s in [-R, 0] (the nodes' rounding,
+        # carried by Chebyshev polynomials bounded by 1), so |ds| <= that / |c'(s)|
+        ds = EPS * (n + 1)**2 * np.max(np.abs(dets[k])) / np.abs(
+            np.polynomial.polynomial.polyval(roots_s, np.polynomial.polynomial.polyder(c)))
+        freq[k], growth[k] = np.abs(lam.imag), lam.real
+        est[k] = 0.5 * ds / np.maximum(np.abs(roots_s), 1e-300)
+    f, g, e = _sorted(freq, growth, est)
+    return Spectrum("polyroots", f, g, e, qe)
+
+
+# --------------------------------------------------------------------------- default
+
+
+def _hermitian_block(M, D, K):
+    """Roots omega > 0 of a gyroscopic block with K > 0, for a batch.
+
+    With d = 1/sqrt(diag K), e = 1/sqrt(diag M) and the Cholesky factors K_s = Lk Lk^T,
+    M_s = Lm Lm^T of the scaled matrices, the eigenvalues mu = 1/omega of the Hermitian
+    T = [[-i Lk^-1 D_s Lk^-T, Lk^-1 C Lm^-T], [.^H, 0]], C = d M e, are real: LAPACK's
+    Hermitian solver finds each with an absolute error of order eps ||T|| = eps / omega_min,
+    so the smallest omega keeps its relative accuracy."""
+    N, n = M.shape[0], M.shape[-1]
+    d = 1 / np.sqrt(np.einsum("bii->bi", K))
+    e = 1 / np.sqrt(np.einsum("bii->bi", M))
+    Lk_inv = np.linalg.inv(np.linalg.cholesky(K * d[:, :, None] * d[:, None, :]))
+    Lm_inv = np.linalg.inv(np.linalg.cholesky(M * e[:, :, None] * e[:, None, :]))
+    T = np.zeros((N, 2 * n, 2 * n), complex)
+    T[:, :n, :n] = -1j * (Lk_inv @ (D * d[:, :, None] * d[:, None, :]) @ Lk_inv.transpose(0, 2, 1))
+    T12 = Lk_inv @ (M * d[:, :, None] * e[:, None, :]) @ Lm_inv.transpose(0, 2, 1)
+    T[:, :n, n:] = T12
+    T[:, n:, :n] = T12.transpose(0, 2, 1)
+    mu = np.linalg.eigvalsh(T)
+    return 1 / mu[:, n:]  # the n positive mu, ascending: omega descending
+
+
+def _start_vectors(N, n, r):
+    """A fixed generic complex start vector for inverse iteration (seeded: reproducible)."""
+    rng = np.random.default_rng(20261124)
+    v = rng.standard_normal(n) + 1j * rng.standard_normal(n)
+    return np.broadcast_to(v, (N, r, n))
+
+
+def _mv(A, z, sym):
+    """A z for a batch of real (B, n, n) matrices and complex vectors z (B, r, n); A is
+    symmetric (sym = 1) or skew (sym = -1), so that z @ A^T = sym z @ A."""
+    out = np.matmul(z.real, A) + 1j * np.matmul(z.imag, A)
+    return out if sym == 1 else -out
+
+
+def _rayleigh_step(M, D, K, w, z):
+    """One step on a batch: M, D, K (B, n, n), shifts w (B, r), vectors z (B, r, n).
+
+    Inverse iteration on the full Hermitian J(i w) = K - w^2 M + i w D, z <- J^-1 J' z, then
+    w from the Rayleigh functional z* J(i w) z = 0 (a quadratic in w: its root nearest the
+    shift). The estimate is the first-order bound |J z| / |z* J' z| from the residual, plus
+    the rounding floor of forming J z. Returns (w, z, estimate, ok)."""
+    n = M.shape[-1]
+    ws = w[..., None, None]
+    J = np.empty(w.shape + (n, n), complex)
+    np.multiply(ws**2, M[:, None], out=J.real)  # in place: no (B, r, n, n) temporaries
+    np.subtract(K[:, None], J.real, out=J.real)
+    np.multiply(ws, D[:, None], out=J.imag)
+    rhs = -2 * w[..., None] * _mv(M, z, 1) + 1j * _mv(D, z, -1)
+    try:
+        zn = np.linalg.solve(J, rhs[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        # a shift on a root to the last bit makes J exactly singular (omega_p = 780 at the
+        # example); inverse iteration only needs a shift near the root
+        ws = ws * (1 + 64 * EPS)
+        np.multiply(ws**2, M[:, None], out=J.real)
+        np.subtract(K[:, None], J.real, out=J.real)
+        np.multiply(ws, D[:, None], out=J.imag)
+        zn = np.linalg.solve(J, rhs[..., None])[..., 0]
+    zn /= np.linalg.norm(zn, axis=-1, keepdims=True)
+    Mz, Dz, Kz = _mv(M, zn, 1), _mv(D, zn, -1), _mv(K, zn, 1)
+    zc = zn.conj()
+    a = np.sum(zc * Mz, axis=-1).real
+    beta = np.sum(zc * Dz, axis=-1).imag
+    c = np.sum(zc * Kz, axis=-1).real
+    # a w^2 + beta w - c = 0: roots q/a and -c/q, without cancellation
+    disc = beta**2 + 4 * a * c
+    sq = np.sqrt(np.maximum(disc, 0.0))
+    q = -(beta + np.copysign(sq, beta)) / 2
+    r1, r2 = q / a, -c / q
+    wn = np.where(np.abs(r1 - w) < np.abs(r2 - w), r1, r2)
+    wc = wn[..., None]
+    res = np.linalg.norm(Kz - wc**2 * Mz + 1j * wc * Dz, axis=-1)
+    az = np.abs(zn) + 0j
+    floor = np.linalg.norm(_mv(np.abs(K), az, 1).real + wc**2 * _mv(np.abs(M), az, 1).real
+                           + np.abs(wc) * _mv(np.abs(D), az, 1).real, axis=-1)
+    est = (res + 4 * n * EPS * floor) / (np.abs(2 * wn * a + beta) * np.abs(wn))
+    ok = (disc > 0) & np.isfinite(est) & (wn > 0)
+    return wn, zn, est, ok
+
+
+def _rayleigh(M, D, K, w, z, iters, tol, chunk=256):
+    """_rayleigh_step on every root, in chunks of sets (cache-sized), then further steps
+    only on the roots whose estimate still exceeds tol. Returns (w, estimate, ok)."""
+    N = M.shape[0]
+    w, z = w.copy(), np.array(z, dtype=complex)
+    est = np.full(w.shape, np.inf)
+    ok = np.zeros(w.shape, bool)
+    for s in range(0, N, chunk):
+        sl = slice(s, s + chunk)
+        w[sl], z[sl], est[sl], ok[sl] = _rayleigh_step(M[sl], D[sl], K[sl], w[sl], z[sl])
+    for _ in range(iters - 1):
+        bi, ri = np.nonzero(ok & (est > tol))
+        if bi.size == 0:
+            break
+        wn, zn, e, o = _rayleigh_step(M[bi], D[bi], K[bi], w[bi, ri][:, None], z[bi, ri][:, None])
+        w[bi, ri], z[bi, ri], est[bi, ri], ok[bi, ri] = wn[:, 0], zn[:, 0], e[:, 0], o[:, 0]
+    return w, est, ok
+
+
+def _general(M, D, K):
+    """The general rung for one set: companion eigenvalues, each refined by Newton on J.
+
+    The estimate is the last Newton step (quadratic convergence leaves far less) plus the
+    rounding floor eps |y| (|M||l|^2 + |D||l| + |K|) |x| / (|l| |y* J'(l) x|) of the root,
+    with x, y the singular vectors of J(l) at its smallest singular value."""
+    n = M.shape[0]
+    lams = modal._companion_eigenvalues(M, D, K)
+    roots, errs = modal.refine_all(M, D, K, lams, modal.representatives(lams, n))
+    est = np.empty(n)
+    for j, lam in enumerate(roots):
+        U, _, Vh = np.linalg.svd(M * lam**2 + D * lam + K)
+        x, y = Vh[-1].conj(), U[:, -1]
+        scale = np.abs(y) @ (np.abs(M) * abs(lam)**2 + np.abs(D) * abs(lam) + np.abs(K)) @ np.abs(x)
+        slope = abs(y.conj() @ (2 * M * lam + D) @ x) * max(abs(lam), 1e-300)
+        est[j] = errs[j] + 4 * n * EPS * scale / max(slope, 1e-300)
+    return roots, est
+
+
+def default(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
+    N = P.shape[0]
+    qe, ok = equilibria(model, P)
+    M, D, K = operators(model, P, qe)
+    n = M.shape[-1]
+    freq = np.full((N, n), np.nan)
+    growth = np.zeros((N, n))
+    est = np.full((N, n), np.inf)
+    route = np.array(["structured"] * N, dtype=object)
+    good = ok & np.all(np.isfinite(M) & np.isfinite(D) & np.isfinite(K), axis=(1, 2))
+    # K > 0 in every block: the Hermitian path applies (checked per set, LAPACK's Cholesky
+    # fails for the whole batch otherwise)
+    blocks = _blocks(model)
+    kmin = np.full(N, -np.inf)
+    if good.any():
+        kmin[good] = np.min([np.linalg.eigvalsh(K[good][:, b][:, :, b] / np.sqrt(
+            np.einsum("bii->bi", K[good][:, b][:, :, b])[:, :, None]
+            * np.einsum("bii->bi", K[good][:, b][:, :, b])[:, None, :]))[:, 0] for b in blocks], axis=0)
+    herm = good & (kmin > 1e3 * EPS) & np.all(np.einsum("bii->bi", M) > 0, axis=1)
+    h = np.flatnonzero(herm)
+    if h.size:
+        Mh, Dh, Kh = M[h], D[h], K[h]
+        w0 = np.concatenate([_hermitian_block(Mh[:, b][:, :, b], Dh[:, b][:, :, b], Kh[:, b][:, :, b])
+                             for b in blocks], axis=1)
+        w, e, fine = _rayleigh(Mh, Dh, Kh, w0, _start_vectors(h.size, n, n), 3, tol)
+        ws_sorted = np.sort(w, axis=1)
+        distinct = np.all(np.diff(ws_sorted, axis=1) > 1e-8 * ws_sorted[:, 1:], axis=1)
+        fine = np.all(fine, axis=1) & distinct & np.all(e <= tol, axis=1)
+        hf = h[fine]
+        freq[hf], est[hf] = w[fine], e[fine]
+        herm[h[~fine]] = False
+    for k in np.flatnonzero(good & ~herm):
+        route[k] = "general"
+        roots, e = _general(M[k], D[k], K[k])
+        freq[k], growth[k], est[k] = np.abs(roots.imag), roots.real, e
+    for k in np.flatnonzero(~good | (np.max(est, axis=1) > tol)):
+        route[k] = "reference"
+        ref = reference(model, P[k:k + 1])
+        freq[k], growth[k], est[k] = ref.frequencies[0], ref.growth[0], ref.error_estimate[0]
+        qe[k] = ref.equilibrium[0]
+    f, g, e = _sorted(freq, growth, est)
+    return Spectrum("default", f, g, e, qe, route)
+
+
+# --------------------------------------------------------------------------- reference
+
+
+def _mp_equilibrium(model, mf, p, q0, idx, max_iter=60):
+    q = [mpmath.mpf(v) for v in q0]
+    tol = mpmath.mpf(10) ** (-mpmath.mp.dps + 5)
+    for _ in range(max_iter):
+        r = mf.equilibrium_residual(p, q)
+        _, _, K = mf.operator(p, q)
+        Kee = mpmath.matrix([[K[i, j] for j in idx] for i in idx])
+        dq = mpmath.lu_solve(Kee, mpmath.matrix([r[i] for i in idx]))
+        q = [qi + dqi for qi, dqi in zip(q, dq)]
+        if all(abs(d) <= tol * max(abs(v), mpmath.mpf(10) ** -300) for d, v in zip(dq, q)):
+            return q
+    raise modal.EquilibriumError("Newton's method in extended precision did not converge")
+
+
+def reference(model: Model, P: np.ndarray, dps: int = REFERENCE_DPS) -> Spectrum:
+    """Arbitrary precision: the equilibrium by Newton from the double one, the companion
+    eigenvalues by mpmath.eig, each root polished by Newton on det J (trace of J^-1 J')."""
+    import importlib
+
+    mf = importlib.import_module(f"generated.{model.name}.mpmath_functions")
+    reduced = model.meta["reduced"]
+    idx = [reduced.index(c) for c in model.meta["equilibrium_coordinates"]]
+    N = P.shape[0]
+    qe_d, ok = equilibria(model, P)
+    out = None
+    with mpmath.workdps(dps):
+        for k in range(N):
+            p = [mpmath.mpf(float(v)) for v in P[k]]
+            start = qe_d[k] if ok[k] else modal.equilibrium(model, P[k])
+            q = _mp_equilibrium(model, mf, p, start, idx)
+            M, D, K = mf.operator(p, q)
+            n = M.rows
+            if out is None:
+                out = (np.full((N, n), np.nan), np.full((N, n), np.nan), np.full((N, n), np.inf),
+                       np.full((N, len(idx)), np.nan))
+            Minv = mpmath.inverse(M)
+            A = mpmath.zeros(2 * n, 2 * n)
+            B, C = -Minv * K, -Minv * D
+            for i in range(n):
+                A[i, n + i] = 1
+                for j in range(n):
+                    A[n + i, j], A[n + i, n + j] = B[i, j], C[i, j]
+            lams = mpmath.eig(A, left=False, right=False)
+            lam_c = np.array([complex(v) for v in lams])
+            reps = modal.representatives(lam_c, n)
+            chosen = [lams[int(np.argmin(np.abs(lam_c - r)))] for r in reps]
+            for j, lam in enumerate(chosen):
+                J = M * lam**2 + D * lam + K
+                dJ = M * (2 * lam) + D
+                Jinv = mpmath.inverse(J)
+                step = 1 / sum(Jinv[c, i] * dJ[i, c] for c in range(n) for i in range(n))
+                lam = lam - step
+                out[0][k, j] = float(abs(lam.imag))
+                out[1][k, j] = float(lam.real)
+                out[2][k, j] = max(float(abs(step) / abs(lam)), 10.0 ** (-dps + 5))
+            out[3][k] = [float(v) for v in q]
+    f, g, e = _sorted(out[0], out[1], out[2])
+    return Spectrum("reference", f, g, e, out[3])
+
+
+# --------------------------------------------------------------------------- formulas
+
+
+def formulas(model: Model, P: np.ndarray) -> Spectrum:
+    """The model's mode formulas (metadata 'mode_formulas'), compiled C over the batch: for
+    each mode, among its candidate formulas the one whose own error estimate is smallest."""
+    if P.shape[0] > FORMULA_CHUNK:  # cache-sized pieces: the selection is memory-bound
+        parts = [formulas(model, P[s:s + FORMULA_CHUNK]) for s in range(0, P.shape[0], FORMULA_CHUNK)]
+        f, e = (np.concatenate([getattr(x, a) for x in parts]) for a in ("frequencies", "error_estimate"))
+        return Spectrum("formulas", f, np.zeros_like(f), e)
+    with np.errstate(all="ignore"):
+        omega, estimate = _fn(model, "mode_formulas")(P)
+    N = P.shape[0]
+    n = len(model.meta["mode_formulas"])
+    omega, estimate = omega.reshape(N, n, -1), estimate.reshape(N, n, -1)
+    f, e = omega[..., 0], estimate[..., 0]
+    for j in range(1, omega.shape[2]):
+        better = estimate[..., j] < e
+        f = np.where(better, omega[..., j], f)
+        e = np.where(better, estimate[..., j], e)
+    e = np.where(np.isfinite(f) & (f > 0), e, np.inf)  # a formula outside its domain (0/0)
+    order = np.argsort(f, axis=1)
+    f, e = np.take_along_axis(f, order, 1), np.take_along_axis(e, order, 1)
+    return Spectrum("formulas", f, np.zeros_like(f), e)
+
+
+# --------------------------------------------------------------------------- API
+
+
+def spectrum(model: Model, params, method: str = "default", tol: float = DEFAULT_TOL) -> Spectrum:
+    """Natural frequencies of a batch of parameter sets (rows of `params`, in the order of
+    model.param_names) by one method of the ladder."""
+    import time
+
+    if method not in METHODS:
+        raise ValueError(f"method: unknown {method!r}; known: {', '.join(METHODS)}")
+    P = as_batch(model, params)
+    t0 = time.perf_counter()
+    if method == "default":
+        out = default(model, P, tol)
+    else:
+        out = {"formulas": formulas, "polyroots": polyroots, "companion": companion,
+               "reference": reference}[method](model, P)
+    out.seconds = time.perf_counter() - t0
+    return out

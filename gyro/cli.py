@@ -1,6 +1,8 @@
 """The `gyro` command line.
 
-    gyro frequencies MODEL [--set NAME=VALUE]... [--json]
+    gyro frequencies MODEL [--set NAME=VALUE]... [--method NAME] [--json]
+    gyro campbell MODEL [--set NAME=VALUE]... --out FILE.png [--range LO HI] [--points N]
+    gyro stability-map MODEL --x NAME --x-range LO HI --y NAME --y-range LO HI --out FILE.png
     gyro params MODEL
 
 Bad input prints one line on stderr naming the parameter and exits with code 2.
@@ -16,6 +18,7 @@ import numpy as np
 from gyro.models import ParameterError, load
 
 EXIT_USAGE = 2
+METHOD_NAMES = ("formulas", "polyroots", "companion", "default", "reference")  # gyro.ladder.METHODS
 
 
 class _Parser(argparse.ArgumentParser):
@@ -36,33 +39,91 @@ def _parse_sets(items: list[str]) -> dict[str, str]:
     return out
 
 
-def _frequencies(args) -> int:
-    from gyro.modal import natural_frequencies
-
-    model = load(args.model)
+def _model_with_equilibrium(name):
+    model = load(name)
     if model.meta.get("momenta"):
         raise ParameterError(f"{model.name}: its operator depends on the momenta "
                              f"{', '.join(model.meta['momenta'])} of a stationary motion; "
-                             "'frequencies' covers models with a relative equilibrium")
+                             "this command covers models with a relative equilibrium")
+    return model
+
+
+def _frequencies(args) -> int:
+    from gyro import ladder
+
+    model = _model_with_equilibrium(args.model)
     values = model.parameters(_parse_sets(args.set))
-    result = natural_frequencies(model, values)
-    if not np.all(np.isfinite(result.frequencies + result.eigenvalues_re)):
+    if args.method == "formulas" and "mode_formulas" not in model.meta["functions"]:
+        raise ParameterError(f"--method formulas: {model.name} has no approximate formulas")
+    spec = ladder.spectrum(model, model.vector(values), args.method)
+    freqs, growth, est = spec.frequencies[0], spec.growth[0], spec.error_estimate[0]
+    if not np.all(np.isfinite(freqs)):
         raise FloatingPointError("a frequency is not finite")
+    stab = ladder.classify(spec)
+    eq = (None if spec.equilibrium is None else
+          dict(zip(model.meta["equilibrium_coordinates"], map(float, spec.equilibrium[0]))))
     if args.json:
         print(json.dumps({
             "model": model.name,
             "params": values,
-            "frequencies": result.frequencies,
-            "equilibrium": result.equilibrium,
-            "eigenvalues_re": result.eigenvalues_re,
+            "frequencies": [float(w) for w in freqs],
+            "equilibrium": eq,
+            "eigenvalues_re": [float(g) for g in growth],
+            "method": args.method,
+            "error_estimate": [float(e) if np.isfinite(e) else None for e in est],
+            "stability": {"class": str(stab.label[0]), "growth_rate": float(stab.growth_rate[0])},
         }, allow_nan=False))
         return 0
     print(f"{model.meta['title']} ({model.name})")
-    print("natural frequencies of the exact operator about the exact equilibrium:")
-    print(f"{'':>4} {'omega [rad/s]':>16} {'f [Hz]':>14} {'period [s]':>14}")
-    for i, w in enumerate(result.frequencies, 1):
-        period = 2 * 3.141592653589793 / w if w > 0 else float("inf")
-        print(f"{i:>4} {w:>16.9g} {w / (2 * 3.141592653589793):>14.6g} {period:>14.6g}")
+    print(f"natural frequencies by the method '{args.method}'"
+          + (f" (answered by its {spec.route[0]} rung)" if spec.route is not None else "") + ":")
+    print(f"{'':>4} {'omega [rad/s]':>16} {'f [Hz]':>14} {'period [s]':>14} {'rel. error <=':>14}")
+    for i, (w, e) in enumerate(zip(freqs, est), 1):
+        period = 2 * np.pi / w if w > 0 else float("inf")
+        print(f"{i:>4} {w:>16.9g} {w / (2 * np.pi):>14.6g} {period:>14.6g} {e:>14.2g}")
+    label = stab.label[0]
+    print(f"equilibrium: {label}" + (f", growth rate {stab.growth_rate[0]:.6g} 1/s" if label == "unstable" else ""))
+    return 0
+
+
+def _campbell(args) -> int:
+    from gyro import campbell
+
+    model = _model_with_equilibrium(args.model)
+    values = model.parameters(_parse_sets(args.set))
+    lo, hi = args.range
+    if not (0 < lo < hi):
+        raise ParameterError(f"--range: need 0 < LO < HI, got {lo} {hi}")
+    if args.points < 2:
+        raise ParameterError(f"--points: need at least 2, got {args.points}")
+    out = campbell.check_output(args.out)
+    data = campbell.sweep(model, values, lo, hi, args.points, progress=not args.quiet)
+    campbell.plot(model, data, out)
+    print(f"gyro: wrote {out} ({args.points} spins, {data['shaded_fraction']:.0%} of the sweep "
+          "has a formula off by more than 1%)")
+    return 0
+
+
+def _stability_map(args) -> int:
+    from gyro import campbell
+
+    model = _model_with_equilibrium(args.model)
+    values = model.parameters(_parse_sets(args.set))
+    for axis, name, (lo, hi) in (("--x", args.x, args.x_range), ("--y", args.y, args.y_range)):
+        if name not in model.param_names:
+            raise ParameterError(f"{axis} {name!r}: unknown parameter; known: {' '.join(model.param_names)}")
+        if not lo < hi:
+            raise ParameterError(f"{axis}-range: need LO < HI, got {lo} {hi}")
+        for v in (lo, hi):
+            model.parameters({name: v})  # validates the ends of the range
+    if args.points < 2:
+        raise ParameterError(f"--points: need at least 2, got {args.points}")
+    out = campbell.check_output(args.out)
+    grid = campbell.stability_grid(model, values, args.x, args.x_range, args.y, args.y_range,
+                                   args.points, progress=not args.quiet)
+    campbell.plot_stability(model, grid, out)
+    counts = {k: int(np.sum(grid["label"] == k)) for k in ("stable", "marginal", "unstable")}
+    print(f"gyro: wrote {out} ({', '.join(f'{v} {k}' for k, v in counts.items())})")
     return 0
 
 
@@ -82,7 +143,30 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                    help="parameter value in SI units (phi in degrees); repeat as needed")
     f.add_argument("--json", action="store_true", help="print one JSON object")
+    f.add_argument("--method", default="default", choices=METHOD_NAMES,
+                   help="rung of the ladder (default: %(default)s; docs/methods.md)")
     f.set_defaults(run=_frequencies)
+    c = sub.add_parser("campbell", help="Campbell diagram: frequencies against spin, formulas overlaid")
+    c.add_argument("model")
+    c.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help="parameter value in SI units (phi in degrees); repeat as needed")
+    c.add_argument("--out", required=True, metavar="FILE.png", help="image to write")
+    c.add_argument("--range", nargs=2, type=float, default=(0.1, 10.0), metavar=("LO", "HI"),
+                   help="spin range as multiples of the set's H (default: 0.1 10)")
+    c.add_argument("--points", type=int, default=200, help="spins in the sweep (default: 200)")
+    c.add_argument("--quiet", action="store_true", help="no progress bar")
+    c.set_defaults(run=_campbell)
+    s = sub.add_parser("stability-map", help="stability of the equilibrium over two parameters")
+    s.add_argument("model")
+    s.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
+    s.add_argument("--x", required=True, metavar="NAME")
+    s.add_argument("--x-range", nargs=2, type=float, required=True, metavar=("LO", "HI"))
+    s.add_argument("--y", required=True, metavar="NAME")
+    s.add_argument("--y-range", nargs=2, type=float, required=True, metavar=("LO", "HI"))
+    s.add_argument("--points", type=int, default=60, help="grid points per axis (default: 60)")
+    s.add_argument("--out", required=True, metavar="FILE.png")
+    s.add_argument("--quiet", action="store_true", help="no progress bar")
+    s.set_defaults(run=_stability_map)
     p = sub.add_parser("params", help="list a model's parameters with the paper example's values")
     p.add_argument("model")
     p.set_defaults(run=_params)

@@ -40,6 +40,7 @@ DEFAULT_TOL = 1e-10
 EPS = np.finfo(float).eps
 REFERENCE_DPS = 40
 FORMULA_CHUNK = 8192
+WIDE = 1e-6  # a root below WIDE x the largest: the spectrum spans more than six decades
 
 
 @dataclass
@@ -140,7 +141,8 @@ def _blocks(model: Model) -> list[np.ndarray]:
 
 
 def _sorted(freq, growth, est):
-    order = np.argsort(freq, axis=1)
+    """Ascending by frequency, ties (real roots of an unstable set) by growth rate."""
+    order = np.argsort(freq + 1j * growth, axis=1)
     take = lambda a: np.take_along_axis(a, order, axis=1)  # noqa: E731
     return take(freq), take(growth), take(est)
 
@@ -217,7 +219,7 @@ def polyroots(model: Model, P: np.ndarray) -> Spectrum:
         ds = EPS * (n + 1)**2 * np.max(np.abs(dets[k])) / np.abs(
             np.polynomial.polynomial.polyval(roots_s, np.polynomial.polynomial.polyder(c)))
         freq[k], growth[k] = np.abs(lam.imag), lam.real
-        est[k] = 0.5 * ds / np.maximum(np.abs(roots_s), 1e-300)
+        est[k] = np.minimum(0.5 * ds / np.maximum(np.abs(roots_s), 1e-300), np.inf)
     f, g, e = _sorted(freq, growth, est)
     return Spectrum("polyroots", f, g, e, qe)
 
@@ -345,6 +347,29 @@ def _general(M, D, K):
     return roots, est
 
 
+def _general_at(model: Model, p: np.ndarray) -> np.ndarray:
+    qe, _ = equilibria(model, p[None])
+    M, D, K = operators(model, p[None], qe)
+    return _general(M[0], D[0], K[0])[0]
+
+
+def _input_rounding(model: Model, p, roots, solve, rel=4 * EPS) -> np.ndarray:
+    """The part of each root's error that comes from rounding the inputs: when a root lies
+    far below the others (ratio < WIDE), the set is solved again with every parameter
+    moved by `rel` relative (signs fixed, reproducible) and the change of each root,
+    relative, is the estimate; zero otherwise. E.g. at phi = 90 deg, cos(pi phi/180)
+    rounds to 6e-17 instead of 0 and omega1 is rounding noise: the estimate says so."""
+    mags = np.abs(roots)
+    if not np.min(mags) < WIDE * np.max(mags):
+        return np.zeros(len(roots))
+    signs = np.where(np.arange(len(p)) % 2 == 0, 1.0, -1.0)
+    moved = np.sort(np.abs(np.asarray(solve(np.asarray(p) * (1 + rel * signs)))))
+    order = np.argsort(mags)
+    out = np.empty(len(roots))
+    out[order] = np.abs(moved - mags[order]) / np.maximum(mags[order], 1e-300)
+    return out
+
+
 def default(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
     N = P.shape[0]
     qe, ok = equilibria(model, P)
@@ -355,15 +380,16 @@ def default(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
     est = np.full((N, n), np.inf)
     route = np.array(["structured"] * N, dtype=object)
     good = ok & np.all(np.isfinite(M) & np.isfinite(D) & np.isfinite(K), axis=(1, 2))
-    # K > 0 in every block: the Hermitian path applies (checked per set, LAPACK's Cholesky
+    # K > 0 in every block: the Hermitian path applies (checked per set: LAPACK's Cholesky
     # fails for the whole batch otherwise)
     blocks = _blocks(model)
     kmin = np.full(N, -np.inf)
-    if good.any():
-        kmin[good] = np.min([np.linalg.eigvalsh(K[good][:, b][:, :, b] / np.sqrt(
-            np.einsum("bii->bi", K[good][:, b][:, :, b])[:, :, None]
-            * np.einsum("bii->bi", K[good][:, b][:, :, b])[:, None, :]))[:, 0] for b in blocks], axis=0)
-    herm = good & (kmin > 1e3 * EPS) & np.all(np.einsum("bii->bi", M) > 0, axis=1)
+    dK = np.einsum("bii->bi", K)
+    scalable = good & np.all(dK > 0, axis=1) & np.all(np.einsum("bii->bi", M) > 0, axis=1)
+    if scalable.any():
+        Ks = K[scalable] / np.sqrt(dK[scalable][:, :, None] * dK[scalable][:, None, :])
+        kmin[scalable] = np.min([np.linalg.eigvalsh(Ks[:, b][:, :, b])[:, 0] for b in blocks], axis=0)
+    herm = scalable & (kmin > 1e3 * EPS)
     h = np.flatnonzero(herm)
     if h.size:
         Mh, Dh, Kh = M[h], D[h], K[h]
@@ -372,13 +398,17 @@ def default(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
         w, e, fine = _rayleigh(Mh, Dh, Kh, w0, _start_vectors(h.size, n, n), 3, tol)
         ws_sorted = np.sort(w, axis=1)
         distinct = np.all(np.diff(ws_sorted, axis=1) > 1e-8 * ws_sorted[:, 1:], axis=1)
-        fine = np.all(fine, axis=1) & distinct & np.all(e <= tol, axis=1)
+        # a root far below the others (omega1 -> 0 toward the pole or as u -> 0) carries the
+        # rounding of the inputs themselves: such sets take the general rung, which measures it
+        wide = np.min(w, axis=1) < WIDE * np.max(w, axis=1)
+        fine = np.all(fine, axis=1) & distinct & np.all(e <= tol, axis=1) & ~wide
         hf = h[fine]
         freq[hf], est[hf] = w[fine], e[fine]
         herm[h[~fine]] = False
     for k in np.flatnonzero(good & ~herm):
         route[k] = "general"
         roots, e = _general(M[k], D[k], K[k])
+        e = e + _input_rounding(model, P[k], roots, lambda Pp: _general_at(model, Pp))
         freq[k], growth[k], est[k] = np.abs(roots.imag), roots.real, e
     for k in np.flatnonzero(~good | (np.max(est, axis=1) > tol)):
         route[k] = "reference"
@@ -392,7 +422,7 @@ def default(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
 # --------------------------------------------------------------------------- reference
 
 
-def _mp_equilibrium(model, mf, p, q0, idx, max_iter=60):
+def _mp_equilibrium(mf, p, q0, idx, max_iter=60):
     q = [mpmath.mpf(v) for v in q0]
     tol = mpmath.mpf(10) ** (-mpmath.mp.dps + 5)
     for _ in range(max_iter):
@@ -406,9 +436,38 @@ def _mp_equilibrium(model, mf, p, q0, idx, max_iter=60):
     raise modal.EquilibriumError("Newton's method in extended precision did not converge")
 
 
+def _reference_roots(mf, p, start, idx):
+    """One set in the working precision: (roots, their last Newton steps relative, q)."""
+    q = _mp_equilibrium(mf, p, start, idx)
+    M, D, K = mf.operator(p, q)
+    n = M.rows
+    Minv = mpmath.inverse(M)
+    A = mpmath.zeros(2 * n, 2 * n)
+    B, C = -Minv * K, -Minv * D
+    for i in range(n):
+        A[i, n + i] = 1
+        for j in range(n):
+            A[n + i, j], A[n + i, n + j] = B[i, j], C[i, j]
+    lams = mpmath.eig(A, left=False, right=False)
+    lam_c = np.array([complex(v) for v in lams])
+    roots, steps = [], []
+    for r in modal.representatives(lam_c, n):
+        lam = lams[int(np.argmin(np.abs(lam_c - r)))]
+        J = M * lam**2 + D * lam + K
+        dJ = M * (2 * lam) + D
+        Jinv = mpmath.inverse(J)
+        step = 1 / sum(Jinv[c, i] * dJ[i, c] for c in range(n) for i in range(n))
+        lam = lam - step
+        roots.append(lam)
+        steps.append(abs(step) / abs(lam) if lam != 0 else mpmath.inf)
+    return roots, steps, q
+
+
 def reference(model: Model, P: np.ndarray, dps: int = REFERENCE_DPS) -> Spectrum:
     """Arbitrary precision: the equilibrium by Newton from the double one, the companion
-    eigenvalues by mpmath.eig, each root polished by Newton on det J (trace of J^-1 J')."""
+    eigenvalues by mpmath.eig, each root polished by Newton on det J (trace of J^-1 J').
+    The estimate is the last Newton step, floored at 10^(5 - dps), plus the effect of the
+    inputs' rounding in this precision where a root lies far below the others."""
     import importlib
 
     mf = importlib.import_module(f"generated.{model.name}.mpmath_functions")
@@ -421,35 +480,28 @@ def reference(model: Model, P: np.ndarray, dps: int = REFERENCE_DPS) -> Spectrum
         for k in range(N):
             p = [mpmath.mpf(float(v)) for v in P[k]]
             start = qe_d[k] if ok[k] else modal.equilibrium(model, P[k])
-            q = _mp_equilibrium(model, mf, p, start, idx)
-            M, D, K = mf.operator(p, q)
-            n = M.rows
+            roots, steps, q = _reference_roots(mf, p, start, idx)
+            n = len(roots)
             if out is None:
-                out = (np.full((N, n), np.nan), np.full((N, n), np.nan), np.full((N, n), np.inf),
-                       np.full((N, len(idx)), np.nan))
-            Minv = mpmath.inverse(M)
-            A = mpmath.zeros(2 * n, 2 * n)
-            B, C = -Minv * K, -Minv * D
-            for i in range(n):
-                A[i, n + i] = 1
-                for j in range(n):
-                    A[n + i, j], A[n + i, n + j] = B[i, j], C[i, j]
-            lams = mpmath.eig(A, left=False, right=False)
-            lam_c = np.array([complex(v) for v in lams])
-            reps = modal.representatives(lam_c, n)
-            chosen = [lams[int(np.argmin(np.abs(lam_c - r)))] for r in reps]
-            for j, lam in enumerate(chosen):
-                J = M * lam**2 + D * lam + K
-                dJ = M * (2 * lam) + D
-                Jinv = mpmath.inverse(J)
-                step = 1 / sum(Jinv[c, i] * dJ[i, c] for c in range(n) for i in range(n))
-                lam = lam - step
-                out[0][k, j] = float(abs(lam.imag))
-                out[1][k, j] = float(lam.real)
-                out[2][k, j] = max(float(abs(step) / abs(lam)), 10.0 ** (-dps + 5))
+                out = [np.full((N, n), np.nan), np.full((N, n), np.nan), np.full((N, n), np.inf),
+                       np.full((N, len(idx)), np.nan)]
+            lam = np.array([complex(r) for r in roots])
+            est = np.maximum(np.array([float(x) for x in steps]), 10.0 ** (5 - dps))
+
+            def solve_moved(_, p=p, start=start):  # the same move, in this precision
+                moved = _moved(p, mpmath.mpf(10) ** (3 - dps))
+                return [complex(r) for r in _reference_roots(mf, moved, start, idx)[0]]
+
+            est = est + _input_rounding(model, P[k], lam, solve_moved)
+            out[0][k], out[1][k], out[2][k] = np.abs(lam.imag), lam.real, est
             out[3][k] = [float(v) for v in q]
     f, g, e = _sorted(out[0], out[1], out[2])
     return Spectrum("reference", f, g, e, out[3])
+
+
+def _moved(p, rel):
+    """Every parameter moved by rel relative, with the alternating signs of _input_rounding."""
+    return [v * (1 + (rel if i % 2 == 0 else -rel)) for i, v in enumerate(p)]
 
 
 # --------------------------------------------------------------------------- formulas
@@ -497,3 +549,32 @@ def spectrum(model: Model, params, method: str = "default", tol: float = DEFAULT
                "reference": reference}[method](model, P)
     out.seconds = time.perf_counter() - t0
     return out
+
+
+# --------------------------------------------------------------------------- stability
+
+
+@dataclass
+class Stability:
+    """Per set: 'stable', 'unstable' (with its growth rate, 1/s) or 'marginal' (a root
+    whose real part, or whose frequency, is zero only within its error estimate)."""
+
+    label: np.ndarray  # (sets,) str
+    growth_rate: np.ndarray  # (sets,) largest real part, 1/s (0 when stable)
+
+
+def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
+    """Stability of each set's equilibrium from its spectrum.
+
+    A root grows when its real part exceeds what its error allows: max(estimate, rel)
+    times |lambda| (the conservative gyroscopic spectrum lies on the imaginary axis, so a
+    real part within rounding of it is noise). A root with |lambda| within its own error of
+    zero (estimate >= 1: a neutral direction, omega1 at the pole or without Earth rate) is
+    marginal."""
+    lam = np.abs(spec.growth + 1j * spec.frequencies)
+    allow = np.maximum(np.nan_to_num(spec.error_estimate, nan=np.inf), rel) * lam
+    growing = spec.growth > allow
+    neutral = np.nan_to_num(spec.error_estimate, nan=np.inf) >= 1
+    label = np.where(growing.any(axis=1), "unstable", np.where(neutral.any(axis=1), "marginal", "stable"))
+    rate = np.where(growing, spec.growth, 0.0).max(axis=1)
+    return Stability(label.astype(object), rate)

@@ -25,8 +25,8 @@ PARAMETERS = [
     Parameter("m", "kg", _m, "rotor mass"),
     Parameter("M", "kg", 0.6, "casing (sensing element without rotor) mass"),
     Parameter("l", "m", 0.15, "torsion bar length"),
-    Parameter("l1", "m", 0.15, "distance O' to casing mass centre O1"),
-    Parameter("l2", "m", 0.25, "distance O' to rotor centre O2"),
+    Parameter("l1", "m", 0.15, "distance O' to casing mass centre O1, downward (< 0: above O')", kind="real"),
+    Parameter("l2", "m", 0.25, "distance O' to rotor centre O2, downward (< 0: above O')", kind="real"),
     Parameter("A", "kg m^2", _A, "rotor equatorial moment of inertia"),
     Parameter("C", "kg m^2", 1.8e-4, "rotor polar moment of inertia"),
     Parameter("I1", "kg m^2", 1.05e-2, "casing moment of inertia about x1"),
@@ -400,14 +400,16 @@ def mode_formulas(F):
     of second order), delta6^2 for (3.9), mu1 + kappa6 for (3.26) (first order in mu1, plus
     the gravity shift the quartic omits), k^2 + kappa6 for the small-k variant (3.28). For
     (3.2) corrected it is omega1/omega_y (the next-order coupling with the rotor's angular
-    spring). Constants are 1 except 3 for (3.28); each is checked against the exact spectrum
+    spring; its constant 2, and the rounding of u2 near the pole). Constants are 1 except 3
+    for (3.28) and 2 for (3.2); each is checked against the exact spectrum
     over the spreads of `make bench` and on random sets (tests/test_ladder.py). The two
     nutation families are candidates of the same four modes: per set, the one whose
     estimate is smaller applies (3.26 when k is large, 3.28 when it is small)."""
     eps2, mu1, k, kappa6, delta6 = F["eps2"], F["mu1"], F["k"], F["kappa6"], F["delta6"]
     big, small = mu1 + kappa6, 3 * (k**2 + kappa6)
     return [
-        ("omega1", [("omega1_eq", F["omega1_eq"] / F["omega_y"])]),
+        # plus the rounding of u2 = u cos(phi) near the pole, where omega1 -> 0
+        ("omega1", [("omega1_eq", 2 * F["omega1_eq"] / F["omega_y"] + sp.Float(2.0**-52) * u / F["u2"])]),
         ("omega2", [("omega2_eq", eps2**2)]),
         ("omega3", [("omega3_eq", eps2)]),
         ("omega4", [("omega4_eq", eps2)]),

@@ -141,8 +141,9 @@ def _blocks(model: Model) -> list[np.ndarray]:
 
 
 def _sorted(freq, growth, est):
-    """Ascending by frequency, ties (real roots of an unstable set) by growth rate."""
-    order = np.argsort(freq + 1j * growth, axis=1)
+    """Ascending by |lambda|: by frequency for a stable set, and the real roots of an
+    unstable set (frequency 0 up to rounding) by their growth rate, in every method alike."""
+    order = np.argsort(np.abs(growth + 1j * freq), axis=1)
     take = lambda a: np.take_along_axis(a, order, axis=1)  # noqa: E731
     return take(freq), take(growth), take(est)
 

@@ -1,4 +1,5 @@
-"""`python -m bench` (or `make bench`): speed of the derivation against a baseline, in one run.
+"""`python -m bench` (or `make bench`): speed of the derivation against a baseline, in one run,
+and the accuracy-against-speed chart of the frequency methods (bench/ladder.py).
 
 The baseline derives the same operator J(p) with sympy.physics.mechanics (LagrangesMethod
 and its linearizer, bench/baseline_mechanics.py), bounded by 600 s; this project's
@@ -74,8 +75,14 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m bench", description=__doc__)
     ap.add_argument("--timeout", type=float, default=600.0, help="bound on the baseline (s)")
     ap.add_argument("--skip-baseline", action="store_true", help="time this project only")
+    ap.add_argument("--only", choices=("derive", "ladder"), help="run one bench only")
     args = ap.parse_args(argv)
     RESULTS.mkdir(parents=True, exist_ok=True)
+    if args.only != "derive":
+        # accuracy against speed of the frequency methods, in a fresh one-thread process
+        subprocess.run([sys.executable, "-m", "bench.ladder"], cwd=ROOT, check=True)
+    if args.only == "ladder":
+        return 0
     res = bench_derive(args.timeout, args.skip_baseline)
     res["machine"] = {"python": platform.python_version(), "processor": platform.machine(),
                       "cores": __import__("os").cpu_count()}

@@ -142,7 +142,7 @@ def plot_stability(model: Model, grid: dict, out: Path):
     g = np.where(grid["growth"] > 0, grid["growth"], np.nan)
     if np.any(np.isfinite(g)):
         cs = ax.contour(grid["x"], grid["y"], np.log10(g), colors="k", linewidths=0.6)
-        ax.clabel(cs, fmt=lambda v: f"1e{v:.0f}/s", fontsize=7)
+        ax.clabel(cs, fmt=lambda v: f"{10**v:.2g}/s", fontsize=7)
     for name, color in (("stable", "#cfe8cf"), ("marginal", "#f3e3a1"), ("unstable", "#f2b8b0")):
         ax.fill_between([], [], color=color, label=name)
     ax.set_xlabel(f"{grid['xname']} [{units[grid['xname']]}]")

@@ -205,22 +205,29 @@ def polyroots(model: Model, P: np.ndarray) -> Spectrum:
         J = (M[:, None] * s[..., None, None] + D[:, None] * p[..., None, None] + K[:, None])
         dets = np.linalg.det(J).real  # J(i w) is Hermitian: det is real
     for k in np.flatnonzero(ok & np.all(np.isfinite(dets), axis=1)):
-        # in x = 2 s / R + 1 the nodes are t; the power basis in s follows by substitution
-        cheb = np.polynomial.chebyshev.chebfit(t, dets[k], n)
-        poly_x = np.polynomial.chebyshev.cheb2poly(cheb)
-        poly_s = np.polynomial.polynomial.Polynomial(poly_x)(np.polynomial.polynomial.Polynomial([-1.0, -2.0 / R[k]]))
-        c = poly_s.coef
+        # in x = -1 - 2 s / R the nodes are t; the power basis in s follows by substitution
+        x_of_s = np.polynomial.polynomial.Polynomial([-1.0, -2.0 / R[k]])
+
+        def to_s(cheb):
+            coef = np.polynomial.polynomial.Polynomial(np.polynomial.chebyshev.cheb2poly(cheb))(x_of_s).coef
+            return np.pad(coef, (0, n + 1 - len(coef)))
+
+        c = to_s(np.polynomial.chebyshev.chebfit(t, dets[k], n))
         roots_s = np.roots(c[::-1])
         lam = np.sqrt(roots_s.astype(complex))  # p = sqrt(s), the upper member
         lam = np.where(lam.imag < 0, -lam, lam)
         if len(lam) != n:
             continue
-        # the fit errs by about eps max|det| at every s in [-R, 0] (the nodes' rounding,
-        # carried by Chebyshev polynomials bounded by 1), so |ds| <= that / |c'(s)|
-        ds = EPS * (n + 1)**2 * np.max(np.abs(dets[k])) / np.abs(
+        # the fit errs by about eps max|det| per Chebyshev coefficient; carried into the power
+        # basis by the conversion (its matrix in absolute value), then into each root by
+        # |ds| <= sum_j |dc_j| |s|^j / |c'(s)|
+        conv = np.abs(np.array([to_s(np.eye(n + 1)[j]) for j in range(n + 1)]))  # (cheb, power)
+        dc = EPS * (n + 1) * np.max(np.abs(dets[k])) * conv.sum(axis=0)
+        ds = np.polynomial.polynomial.polyval(np.abs(roots_s), dc) / np.abs(
             np.polynomial.polynomial.polyval(roots_s, np.polynomial.polynomial.polyder(c)))
         freq[k], growth[k] = np.abs(lam.imag), lam.real
-        est[k] = np.minimum(0.5 * ds / np.maximum(np.abs(roots_s), 1e-300), np.inf)
+        e = 0.5 * ds / np.maximum(np.abs(roots_s), 1e-300)
+        est[k] = np.where(e < 0.5, e, np.inf)  # a first-order bound past 1/2 bounds nothing
     f, g, e = _sorted(freq, growth, est)
     return Spectrum("polyroots", f, g, e, qe)
 
@@ -278,16 +285,23 @@ def _rayleigh_step(M, D, K, w, z):
     np.subtract(K[:, None], J.real, out=J.real)
     np.multiply(ws, D[:, None], out=J.imag)
     rhs = -2 * w[..., None] * _mv(M, z, 1) + 1j * _mv(D, z, -1)
-    try:
-        zn = np.linalg.solve(J, rhs[..., None])[..., 0]
-    except np.linalg.LinAlgError:
+    zn = None
+    for shift in (0.0, 64 * EPS, 1e-10, 1e-7):
         # a shift on a root to the last bit makes J exactly singular (omega_p = 780 at the
-        # example); inverse iteration only needs a shift near the root
-        ws = ws * (1 + 64 * EPS)
-        np.multiply(ws**2, M[:, None], out=J.real)
-        np.subtract(K[:, None], J.real, out=J.real)
-        np.multiply(ws, D[:, None], out=J.imag)
-        zn = np.linalg.solve(J, rhs[..., None])[..., 0]
+        # example); inverse iteration only needs a shift near the root, so move it a little
+        if shift:
+            wt = ws * (1 + shift)
+            np.multiply(wt**2, M[:, None], out=J.real)
+            np.subtract(K[:, None], J.real, out=J.real)
+            np.multiply(wt, D[:, None], out=J.imag)
+        try:
+            zn = np.linalg.solve(J, rhs[..., None])[..., 0]
+            break
+        except np.linalg.LinAlgError:
+            continue
+    if zn is None:  # singular at every shift (e.g. a zero mass): this rung gives up
+        nan = np.full(w.shape, np.nan)
+        return nan, z, np.full(w.shape, np.inf), np.zeros(w.shape, bool)
     zn /= np.linalg.norm(zn, axis=-1, keepdims=True)
     Mz, Dz, Kz = _mv(M, zn, 1), _mv(D, zn, -1), _mv(K, zn, 1)
     zc = zn.conj()
@@ -312,7 +326,7 @@ def _rayleigh_step(M, D, K, w, z):
 
 def _rayleigh(M, D, K, w, z, iters, tol, chunk=256):
     """_rayleigh_step on every root, in chunks of sets (cache-sized), then further steps
-    only on the roots whose estimate still exceeds tol. Returns (w, estimate, ok)."""
+    only on the roots whose estimate still exceeds tol. Returns (w, z, estimate, ok)."""
     N = M.shape[0]
     w, z = w.copy(), np.array(z, dtype=complex)
     est = np.full(w.shape, np.inf)
@@ -326,7 +340,7 @@ def _rayleigh(M, D, K, w, z, iters, tol, chunk=256):
             break
         wn, zn, e, o = _rayleigh_step(M[bi], D[bi], K[bi], w[bi, ri][:, None], z[bi, ri][:, None])
         w[bi, ri], z[bi, ri], est[bi, ri], ok[bi, ri] = wn[:, 0], zn[:, 0], e[:, 0], o[:, 0]
-    return w, est, ok
+    return w, z, est, ok
 
 
 def _general(M, D, K):
@@ -371,6 +385,23 @@ def _input_rounding(model: Model, p, roots, solve, rel=4 * EPS) -> np.ndarray:
     return out
 
 
+def _input_rounding_structured(model: Model, P, w, z, rel=4 * EPS):
+    """_input_rounding for the structured rung, batched: the smallest root of each set is
+    followed to the moved inputs by one Rayleigh step from its converged vector."""
+    signs = np.where(np.arange(P.shape[1]) % 2 == 0, 1.0, -1.0)
+    Pm = P * (1 + rel * signs)
+    qe, _ = equilibria(model, Pm)
+    M, D, K = operators(model, Pm, qe)
+    j = np.argmin(w, axis=1)
+    rows = np.arange(len(w))
+    w_small = w[rows, j]
+    wm, _, _, ok = _rayleigh_step(M, D, K, w_small[:, None], z[rows, j][:, None])
+    change = np.where(ok[:, 0], np.abs(wm[:, 0] - w_small) / w_small, np.inf)
+    out = np.zeros(w.shape)
+    out[rows, j] = change
+    return out
+
+
 def default(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
     N = P.shape[0]
     qe, ok = equilibria(model, P)
@@ -396,13 +427,15 @@ def default(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
         Mh, Dh, Kh = M[h], D[h], K[h]
         w0 = np.concatenate([_hermitian_block(Mh[:, b][:, :, b], Dh[:, b][:, :, b], Kh[:, b][:, :, b])
                              for b in blocks], axis=1)
-        w, e, fine = _rayleigh(Mh, Dh, Kh, w0, _start_vectors(h.size, n, n), 3, tol)
+        w, z, e, fine = _rayleigh(Mh, Dh, Kh, w0, _start_vectors(h.size, n, n), 3, tol)
         ws_sorted = np.sort(w, axis=1)
         distinct = np.all(np.diff(ws_sorted, axis=1) > 1e-8 * ws_sorted[:, 1:], axis=1)
         # a root far below the others (omega1 -> 0 toward the pole or as u -> 0) carries the
-        # rounding of the inputs themselves: such sets take the general rung, which measures it
-        wide = np.min(w, axis=1) < WIDE * np.max(w, axis=1)
-        fine = np.all(fine, axis=1) & distinct & np.all(e <= tol, axis=1) & ~wide
+        # rounding of the inputs themselves: measured by solving again with moved inputs
+        wide = np.flatnonzero(np.all(fine, axis=1) & (np.min(w, axis=1) < WIDE * np.max(w, axis=1)))
+        if wide.size:
+            e[wide] += _input_rounding_structured(model, P[h[wide]], w[wide], z[wide])
+        fine = np.all(fine, axis=1) & distinct & np.all(e <= tol, axis=1)
         hf = h[fine]
         freq[hf], est[hf] = w[fine], e[fine]
         herm[h[~fine]] = False

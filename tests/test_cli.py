@@ -49,7 +49,7 @@ def test_human_output_lists_ten_frequencies():
     (["--set", "A=inf"], "A"),
     (["--set", "m=0"], "m"),
     (["--set", "M=-0.6"], "M"),
-    (["--set", "l2=-1"], "l2"),
+    (["--set", "Kp=-1"], "Kp"),
     (["--set", "I3=0"], "I3"),
     (["--set", "Kgamma=-5"], "Kgamma"),
     (["--set", "K0=0"], "K0"),

@@ -1,0 +1,167 @@
+"""Accuracy against speed of the ladder of methods (gyro.ladder), in one run, on one core.
+
+`python -m bench.ladder` (run by `make bench`): on the paper example and on three spreads
+(spin Omega 0.1x..10x, bearing stiffnesses K0, Kp, K_gamma together 0.1x..10x, latitude
+0..89 deg) every method's frequencies are compared with the 40-digit reference, and each
+method's time per parameter set is measured over a batch in the same run. Writes
+bench/results/ladder.json and the charts ladder_accuracy_speed.png, campbell.png and
+stability_map.png (shown in the README).
+"""
+from __future__ import annotations
+
+import os
+
+for _v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_v] = "1"  # one core: set before NumPy loads its BLAS
+
+import json  # noqa: E402
+import platform  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from gyro import campbell, ladder, load  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+RESULTS = ROOT / "bench" / "results"
+MODEL = load("torsion_gyrocompass")
+GOALS = {"default_sets_per_s": 20000, "default_rel_error": 1e-10, "formulas_sets_per_s": 5e6,
+         "reference_s_per_set": 1.0}
+BATCH = {"formulas": 1_000_000, "polyroots": 300, "companion": 20000, "default": 20000}
+SPREAD_POINTS = 9
+
+
+def spreads() -> dict[str, np.ndarray]:
+    p0 = MODEL.vector(MODEL.defaults)
+    ix = {n: i for i, n in enumerate(MODEL.param_names)}
+    s = np.geomspace(0.1, 10, SPREAD_POINTS)
+    spin = np.tile(p0, (len(s), 1))
+    spin[:, ix["H"]] *= s
+    stiff = np.tile(p0, (len(s), 1))
+    for k in ("K0", "Kp", "Kgamma"):
+        stiff[:, ix[k]] *= s
+    lat = np.tile(p0, (SPREAD_POINTS, 1))
+    lat[:, ix["phi"]] = np.linspace(0, 89, SPREAD_POINTS)
+    return {"paper example": p0[None], "spin 0.1x..10x": spin, "bearing stiffness 0.1x..10x": stiff,
+            "latitude 0..89 deg": lat}
+
+
+def rel_errors(s: ladder.Spectrum, r: ladder.Spectrum) -> np.ndarray:
+    lam = s.growth + 1j * s.frequencies
+    lr = r.growth + 1j * r.frequencies
+    return np.abs(lam - lr) / np.abs(lr)
+
+
+def time_per_set(method: str, P: np.ndarray) -> float:
+    n = BATCH[method]
+    big = np.tile(P, (int(np.ceil(n / len(P))), 1))[:n]
+    ladder.spectrum(MODEL, big[:4], method)  # warm: compile, imports
+    best = np.inf
+    for _ in range(2 if method != "formulas" else 3):
+        t0 = time.perf_counter()
+        ladder.spectrum(MODEL, big, method)
+        best = min(best, (time.perf_counter() - t0) / n)
+    return best
+
+
+def main() -> int:
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    out = {"goals": GOALS, "spreads": {}, "machine": {
+        "python": platform.python_version(), "processor": platform.machine(), "threads": 1}}
+    all_sets = np.concatenate(list(spreads().values()))
+    print("timing each method over a batch (one core) ...", flush=True)
+    timing = {m: time_per_set(m, all_sets) for m in BATCH}
+    for m, t in timing.items():
+        print(f"  {m:10s} {t * 1e6:10.3f} us per set ({1 / t:,.0f} sets/s)", flush=True)
+    ref_times = []
+    for name, P in spreads().items():
+        print(f"{name}: reference on {len(P)} sets ...", flush=True)
+        t0 = time.perf_counter()
+        r = ladder.spectrum(MODEL, P, "reference")
+        ref_times.append((time.perf_counter() - t0) / len(P))
+        entry = {"sets": len(P), "methods": {}}
+        for m in ("formulas", "polyroots", "companion", "default", "reference"):
+            s = r if m == "reference" else ladder.spectrum(MODEL, P, m)
+            if m == "formulas":  # approximate modes: distance to the nearest exact root
+                err = campbell.nearest_error(s.frequencies, r.frequencies)
+            elif m == "reference":
+                err = s.error_estimate
+            else:
+                err = rel_errors(s, r)
+            bound_held = bool(np.all(err <= s.error_estimate)) if m != "reference" else True
+            entry["methods"][m] = {
+                "max_rel_error_per_frequency": [float(x) for x in np.nanmax(err, axis=0)],
+                "max_rel_error": float(np.nanmax(err)),
+                "estimate_bounds_error": bound_held,
+                "routes": (sorted(set(s.route)) if s.route is not None else None)}
+            print(f"  {m:10s} max error {np.nanmax(err):9.2e}  estimate bounds it: {bound_held}", flush=True)
+        out["spreads"][name] = entry
+    timing["reference"] = float(np.mean(ref_times))
+    out["seconds_per_set"] = timing
+    out["sets_per_s"] = {m: 1 / t for m, t in timing.items()}
+    worst_default = max(e["methods"]["default"]["max_rel_error"] for e in out["spreads"].values())
+    out["standing"] = {
+        "default_sets_per_s": 1 / timing["default"], "default_max_rel_error": worst_default,
+        "formulas_sets_per_s": 1 / timing["formulas"], "reference_s_per_set": timing["reference"]}
+    chart(out)
+    print("Campbell diagram and stability map ...", flush=True)
+    data = campbell.sweep(MODEL, MODEL.defaults, 0.1, 10.0, 240)
+    campbell.plot(MODEL, data, RESULTS / "campbell.png")
+    grid = campbell.stability_grid(MODEL, MODEL.defaults, "l2", (-0.4, 0.4), "Kgamma", (0.5, 200.0), 70)
+    campbell.plot_stability(MODEL, grid, RESULTS / "stability_map.png")
+    out["campbell_shaded_fraction"] = data["shaded_fraction"]
+    path = RESULTS / "ladder.json"
+    path.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
+    st = out["standing"]
+    print(f"default: {st['default_sets_per_s']:,.0f} sets/s (goal 20,000), worst error "
+          f"{st['default_max_rel_error']:.1e} (goal 1e-10); formulas: {st['formulas_sets_per_s']:,.0f} "
+          f"sets/s (goal 5,000,000); reference: {st['reference_s_per_set']:.2f} s/set (goal 1 s)")
+    print(f"written {path.relative_to(ROOT)} and the charts in {RESULTS.relative_to(ROOT)}")
+    return 0
+
+
+def chart(out: dict) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    style = {"formulas": ("tab:blue", "s"), "polyroots": ("tab:red", "v"),
+             "companion": ("tab:orange", "^"), "default": ("tab:green", "o"),
+             "reference": ("tab:purple", "D")}
+    fig, axes = plt.subplots(2, 2, figsize=(11, 8.5), sharex=True, sharey=True, layout="constrained")
+    floor = 1e-17  # an error of exactly zero is drawn here
+    for ax, (name, entry) in zip(axes.ravel(), out["spreads"].items()):
+        for m, (color, marker) in style.items():
+            t = out["seconds_per_set"][m]
+            errs = np.maximum(np.nan_to_num(entry["methods"][m]["max_rel_error_per_frequency"], nan=10.0), floor)
+            errs = np.minimum(errs, 10.0)
+            jitter = t * np.exp(np.linspace(-0.12, 0.12, len(errs)))
+            ax.scatter(jitter, errs, color=color, marker=marker, s=22, alpha=0.8,
+                       label=m if ax is axes[0, 0] else None)
+            ax.annotate("omega1", (jitter[0], errs[0]), fontsize=6, color=color,
+                        xytext=(3, 3), textcoords="offset points")
+        ax.axhline(1e-10, color="k", lw=0.7, ls="--")
+        ax.axvline(1 / GOALS["default_sets_per_s"], color="tab:green", lw=0.7, ls=":")
+        ax.axvline(1 / GOALS["formulas_sets_per_s"], color="tab:blue", lw=0.7, ls=":")
+        ax.axvline(GOALS["reference_s_per_set"], color="tab:purple", lw=0.7, ls=":")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_ylim(5e-18, 20)
+        ax.set_title(f"{name} ({entry['sets']} sets)", fontsize=9)
+        ax.grid(True, which="major", alpha=0.3)
+    for ax in axes[1]:
+        ax.set_xlabel("time per parameter set [s] (one core, batched)")
+    for ax in axes[:, 0]:
+        ax.set_ylabel("max relative error against the reference")
+    axes[0, 0].legend(fontsize=8, loc="center left")
+    fig.suptitle("Natural frequencies of the torsion gyrocompass: accuracy against speed "
+                 "(a point per method and frequency; dashed: 1e-10, dotted: speed goals)", fontsize=10)
+    fig.savefig(RESULTS / "ladder_accuracy_speed.png", dpi=120)
+    plt.close(fig)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

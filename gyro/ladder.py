@@ -110,10 +110,14 @@ def equilibria(model: Model, P: np.ndarray, tol: float = 1e-14, max_iter: int = 
         with np.errstate(all="ignore"):
             r = resid(P[a], qe[a])[0].reshape(a.size, -1)[:, idx]
             K = oper(P[a], qe[a])[2][:, idx][:, :, idx]
+            tame = _tame(K) & np.all(np.abs(r) < 1e150, axis=1)
+            K = np.where(tame[:, None, None], K, np.eye(len(idx)))
+            r = np.where(tame[:, None], r, np.nan)
             try:
                 dq = np.linalg.solve(K, r[..., None])[..., 0]
             except np.linalg.LinAlgError:
-                dq = np.array([np.linalg.lstsq(k, v, rcond=None)[0] for k, v in zip(K, r)])
+                dq = np.array([np.linalg.lstsq(k, v, rcond=None)[0] if t else v
+                               for k, v, t in zip(K, r, tame)])
         big = np.max(np.abs(np.where(is_angle, dq, 0.0)), axis=1)
         dq *= np.minimum(1.0, modal.MAX_ANGLE_STEP / np.maximum(big, 1e-300))[:, None]
         qe[a] += dq
@@ -123,12 +127,31 @@ def equilibria(model: Model, P: np.ndarray, tol: float = 1e-14, max_iter: int = 
         qe[a[bad]] = np.nan
     ok = np.all(np.isfinite(qe), axis=1) & ~active
     qe = np.where(is_angle, modal._wrap(qe), qe)
+    for k in np.flatnonzero(~ok):  # the set-by-set solver, with its acceptance test (g = 0)
+        with np.errstate(all="ignore"):
+            finite = all(_tame(X).all() for X in oper(P[k:k + 1], np.zeros((1, len(names)))))
+        if not finite:  # inputs beyond double precision: LAPACK must not see them
+            qe[k] = np.nan
+            continue
+        try:
+            qe[k] = modal.equilibrium(model, P[k])
+            ok[k] = True
+        except (modal.EquilibriumError, np.linalg.LinAlgError, ValueError, ArithmeticError):
+            qe[k] = np.nan
     return qe, ok
 
 
 def operators(model: Model, P: np.ndarray, qe: np.ndarray):
     with np.errstate(all="ignore"):
         return _fn(model, "operator")(P, qe)
+
+
+def _tame(X) -> np.ndarray:
+    """Per matrix of a batch (or for one matrix): finite and far from overflow (LAPACK
+    squares entries while scaling; beyond 1e150 it overflows and complains on stderr)."""
+    X = np.asarray(X)
+    with np.errstate(invalid="ignore"):
+        return np.all(np.abs(X) < 1e150, axis=(-2, -1))
 
 
 def _blocks(model: Model) -> list[np.ndarray]:
@@ -173,7 +196,7 @@ def companion(model: Model, P: np.ndarray) -> Spectrum:
     M, D, K = operators(model, P, qe)
     n = M.shape[-1]
     A = _companion_matrices(M, D, K)
-    good = ok & np.all(np.isfinite(A), axis=(1, 2))
+    good = ok & _tame(A)
     lam = np.full((P.shape[0], n), np.nan + 0j)
     if good.any():
         lam[good] = _pairs(np.linalg.eigvals(A[good]), n)
@@ -350,6 +373,8 @@ def _general(M, D, K):
     rounding floor eps |y| (|M||l|^2 + |D||l| + |K|) |x| / (|l| |y* J'(l) x|) of the root,
     with x, y the singular vectors of J(l) at its smallest singular value."""
     n = M.shape[0]
+    if not (_tame(M) and _tame(D) and _tame(K)):
+        return np.full(n, np.nan + 0j), np.full(n, np.inf)
     lams = modal._companion_eigenvalues(M, D, K)
     roots, errs = modal.refine_all(M, D, K, lams, modal.representatives(lams, n))
     est = np.empty(n)
@@ -411,7 +436,7 @@ def default(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
     growth = np.zeros((N, n))
     est = np.full((N, n), np.inf)
     route = np.array(["structured"] * N, dtype=object)
-    good = ok & np.all(np.isfinite(M) & np.isfinite(D) & np.isfinite(K), axis=(1, 2))
+    good = ok & _tame(M) & _tame(D) & _tame(K)
     # K > 0 in every block: the Hermitian path applies (checked per set: LAPACK's Cholesky
     # fails for the whole batch otherwise)
     blocks = _blocks(model)
@@ -445,8 +470,14 @@ def default(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
         e = e + _input_rounding(model, P[k], roots, lambda Pp: _general_at(model, Pp))
         freq[k], growth[k], est[k] = np.abs(roots.imag), roots.real, e
     for k in np.flatnonzero(~good | (np.max(est, axis=1) > tol)):
+        try:
+            ref = reference(model, P[k:k + 1])
+        except (modal.EquilibriumError, ArithmeticError, ValueError, np.linalg.LinAlgError):
+            # extended precision cannot answer either (a singular equilibrium problem, as at
+            # g = 0, or inputs beyond any precision): the general rung's answer stands, with
+            # its own (larger) estimate
+            continue
         route[k] = "reference"
-        ref = reference(model, P[k:k + 1])
         freq[k], growth[k], est[k] = ref.frequencies[0], ref.growth[0], ref.error_estimate[0]
         qe[k] = ref.equilibrium[0]
     f, g, e = _sorted(freq, growth, est)
@@ -513,7 +544,9 @@ def reference(model: Model, P: np.ndarray, dps: int = REFERENCE_DPS) -> Spectrum
     with mpmath.workdps(dps):
         for k in range(N):
             p = [mpmath.mpf(float(v)) for v in P[k]]
-            start = qe_d[k] if ok[k] else modal.equilibrium(model, P[k])
+            if not ok[k]:  # equilibria() has tried the set-by-set solver as well
+                raise modal.EquilibriumError(f"no equilibrium in double precision to start from (set {k})")
+            start = qe_d[k]
             roots, steps, q = _reference_roots(mf, p, start, idx)
             n = len(roots)
             if out is None:

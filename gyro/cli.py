@@ -2,6 +2,7 @@
 
     gyro frequencies MODEL [--set NAME=VALUE]... [--json]
     gyro params MODEL
+    gyro simulate gimbal_gyroscope [--set NAME=VALUE]... --t-end T [--points N] [--method NAME] [--json] [--out FILE.png]
 
 Bad input prints one line on stderr naming the parameter and exits with code 2.
 """
@@ -14,6 +15,7 @@ import sys
 import numpy as np
 
 from gyro.models import ParameterError, load
+from gyro.simulate import add_parser as add_simulate
 
 EXIT_USAGE = 2
 
@@ -86,6 +88,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("params", help="list a model's parameters with the paper example's values")
     p.add_argument("model")
     p.set_defaults(run=_params)
+    add_simulate(sub)
     return ap
 
 

@@ -55,8 +55,8 @@ INITIAL = {  # extra parameters of a motion: the initial conditions at t = 0
 _DPS = 40
 
 
-class ClosedFormError(ValueError):
-    """The closed form does not apply to these parameters (C0 != 0); one line."""
+class ClosedFormError(ParameterError):
+    """The closed form does not apply to these parameters (C0 != 0): bad input, one line."""
 
 
 def param_vector(p: dict) -> np.ndarray:

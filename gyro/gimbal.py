@@ -364,7 +364,7 @@ class ClosedForm:
             return np.stack([c * tau, c * c * tau], axis=-1)
         h, cum, tot = self._panels
         k, tr = self._reduce(tau)
-        j = np.minimum(np.floor(tr / h), len(cum) - 2)
+        j = np.clip(np.floor(tr / h), 0, len(cum) - 2)  # tr may round to just outside [0, 2 omega)
         left = j * h
         x, w = np.polynomial.legendre.leggauss(self.GL_NODES)
         nodes = left[..., None] + (tr - left)[..., None] * (x + 1) / 2

@@ -446,27 +446,23 @@ def theta1_property_a(b1: float, b2: float, e: float) -> float:
     return 2 * x
 
 
-def mean_drift_paper(motion: Motion, theta1: float) -> float:
-    """<psi'> by the paper's integral (section 6) between the roots theta0 and theta1 of f:
-    (1/A0) int (L - H cos) / sqrt(f) d theta / int d theta / sqrt(f) (tanh-sinh quadrature,
-    which takes the inverse-square-root ends)."""
-    p = motion.params
+def mean_drift_paper(motion: Motion, theta_a: float, theta_b: float) -> float:
+    """<psi'> by the paper's integral (section 6) between the roots theta_a, theta_b of f
+    that bound the motion: (1/A0) int (L - H cos) / sqrt(f) / int 1 / sqrt(f), f the
+    radicand of (2.2) (tanh-sinh quadrature in mpmath, which takes the 1/sqrt ends)."""
+    p, I = motion.params, motion.integrals0
     with mp.workdps(30):
-        cf = ClosedForm(motion)
-        A0 = mp.mpf(p["A0"])
-        th0 = mp.mpf(motion.theta0)
-        a = A0 * p["P1"] * p["eta20"]
+        A0, H, L, M = (mp.mpf(x) for x in (p["A0"], I["H"], I["L"], I["M"]))
         G = mp.mpf(p["P1"]) * p["eta30"] + mp.mpf(p["P"]) * p["l"]
-        g = A0 * (G - cf.H * mp.mpf(motion.dpsi0))
-        b0 = cf.b_mp[0]
 
-        def f(th):
-            c = mp.cos(th0) - mp.cos(th)
-            return b0 + 2 * a * (mp.sin(th0) - mp.sin(th)) + 2 * g * c - cf.H**2 * c**2
+        def f(th):  # A0 B0 theta'^2 from the integrals (1.2)
+            return A0 * (M - (L - H * mp.cos(th)) ** 2 / A0 - 2 * p["P1"] * p["eta20"] * mp.sin(th)
+                         - 2 * G * mp.cos(th))
 
-        lo, hi = sorted([th0, mp.mpf(theta1)])
-        num = mp.quad(lambda th: (cf.L - cf.H * mp.cos(th)) / mp.sqrt(f(th)), [lo, hi])
-        den = mp.quad(lambda th: 1 / mp.sqrt(f(th)), [lo, hi])
+        # the roots to 30 digits: an end off by d costs ~sqrt(d) in the integrals
+        lo, hi = sorted(mp.findroot(f, mp.mpf(x)) for x in (theta_a, theta_b))
+        num = mp.quad(lambda th: (L - H * mp.cos(th)) / mp.sqrt(abs(f(th))), [lo, hi])
+        den = mp.quad(lambda th: 1 / mp.sqrt(abs(f(th))), [lo, hi])
         return float(num / den / A0)
 
 

@@ -121,8 +121,9 @@ class Weierstrass:
         if disc >= 0:
             e = sorted((mp.re(x) for x in r), reverse=True)
             return e[0], "real", e
-        e2 = min(r, key=lambda x: abs(mp.im(x)))
-        others = [x for x in r if x is not e2]
+        # the real root is the isolated one (near a double root the pair is almost real too)
+        i = max(range(3), key=lambda k: min(abs(r[k] - r[j]) for j in range(3) if j != k))
+        e2, others = r[i], [r[j] for j in range(3) if j != i]
         return mp.re(e2), "complex", [mp.re(e2), *others]
 
     @cached_property
@@ -175,9 +176,9 @@ class Weierstrass:
             return 1 / mp.sqrt(z)
         if kind == "real":
             e3 = self.roots[2][2]
-            return mp.ellipf(mp.asin(mp.sqrt(scale**2 / (z - e3))), m) / scale
+            return mp.ellipf(mp.asin(min(mp.sqrt(scale**2 / (z - e3)), 1)), m) / scale  # z = e1 may round over
         e2, H2 = self.roots[0], scale**2 / 4
-        return mp.ellipf(mp.acos((z - e2 - H2) / (z - e2 + H2)), m) / scale
+        return mp.ellipf(mp.acos(max(min((z - e2 - H2) / (z - e2 + H2), 1), -1)), m) / scale
 
 
 # ------------------------------------------------------------------ the closed form
@@ -262,12 +263,15 @@ class ClosedForm:
                 continue
             t1 = self.wp.inverse(z)
             wpd = mp.sqrt(max(F(z), 0))
-            for tc, w in ((t1, -wpd), (2 * omega - t1, wpd)):
+            # z = e_top: the one instant tau = omega (a crossing there, as in a uniform
+            # rotation, or a tangency, where theta just reaches theta0 +- pi and jump is 0)
+            pair = [(t1, -wpd)] if omega - t1 <= mp.mpf(10) ** (-_DPS // 2) * omega else \
+                [(t1, -wpd), (2 * omega - t1, wpd)]
+            for tc, w in pair:
                 j = self._jump_mp(z, w)
                 if j and tc < 2 * omega:
                     crossings.append((tc, j))
         crossings.sort()
-        # a tangency at tau = omega shows up twice with opposite signs: drop such pairs
         self.crossings = np.array([float(c) for c, _ in crossings])
         self.jumps = np.array([j for _, j in crossings], int)
         self.net_turns = int(self.jumps.sum())  # theta gains 2 pi net_turns per period
@@ -291,9 +295,13 @@ class ClosedForm:
             return 0
         b0, b1, b2 = self.b_mp[:3]
         wpp = 6 * z**2 - self.g2_mp / 2
-        dD = (self.sign * mp.sqrt(b0) * wpp - 2 * b1 * w) if (N is Np) else 4 * (z - b2 / 2) * w
-        x_dot = dD / N  # x = 1/s = D/N passes through 0; theta' ~ -2 x'
-        return 0 if x_dot == 0 else (-1 if x_dot > 0 else 1)
+        terms = ([self.sign * mp.sqrt(b0) * wpp, -2 * b1 * w] if N is Np else [4 * (z - b2 / 2) * w])
+        dD = sum(terms)
+        # x = 1/s = D/N passes through 0 and theta' ~ -2 x'; x' = 0 (to the working precision
+        # against its terms) is a tangency: theta touches theta0 +- pi and turns, no jump
+        if abs(dD) <= mp.mpf(10) ** (-_DPS // 2) * sum(abs(x) for x in terms):
+            return 0
+        return -1 if dD / N > 0 else 1
 
     # ---------------------------------------------------------- evaluation (NumPy)
 

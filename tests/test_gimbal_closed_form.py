@@ -212,3 +212,15 @@ def test_closed_form_C0_nonzero_is_refused():
 
     with pytest.raises(ClosedFormError, match="C0"):
         ClosedForm(Motion(dict(DEFAULTS, C0=0.001), 1.2, 0.0, 1.0, 200.0))
+
+
+@pytest.mark.parametrize("B0", [0.03125, 0.0333230904802231])
+def test_uniform_rotation_without_gravity(B0):
+    """No weight, no rotor momentum: theta = theta0 + theta0' t exactly. F has a double root
+    (below e), which rounding may tip to one real root, and s passes through infinity at the
+    turning instant tau = omega of wp: found by hypothesis, once counted twice (4 pi off)."""
+    p = dict(DEFAULTS, A0=0.03125, B0=B0, A3=0.015625, P1=0.0, eta20=0.0, eta30=0.0, P=0.0, l=0.0)
+    cf = ClosedForm(Motion(p, 0.0, 1.0, 0.0, 0.0))
+    t = np.linspace(0, 10, 1001)
+    assert cf.motion_type == "monotone"
+    assert np.max(np.abs(cf.theta(t) - t)) < 1e-13 * 10

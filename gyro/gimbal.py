@@ -82,14 +82,8 @@ def integrals(p: dict, q, qd) -> dict:
 # ------------------------------------------------------------------ Jacobi and Weierstrass
 
 
-def jacobi(u, m: float, m1: float):
-    """sn, cn, dn(u | m) for real u, 0 <= m <= 1, with m1 = 1 - m given separately (so that
-    m close to 1 keeps its digits): arithmetic-geometric mean, A&S 16.4; vectorised."""
-    u = np.asarray(u, float)
-    if m1 == 0.0:
-        t = np.tanh(u)
-        s = 1.0 / np.cosh(u)
-        return t, s, s
+def _agm(u, m: float, m1: float):
+    """sn, cn, dn(u | m) by the arithmetic-geometric mean (A&S 16.4), m1 = 1 - m given."""
     a, b, c = 1.0, math.sqrt(m1), math.sqrt(m)
     an, cn_ = [a], [c]
     while abs(c) > 1e-17 * a and len(an) < 40:
@@ -102,6 +96,30 @@ def jacobi(u, m: float, m1: float):
         phi = (phi + np.arcsin(cn_[k] / an[k] * np.sin(phi))) / 2
     sn, cn = np.sin(phi), np.cos(phi)
     return sn, cn, np.sqrt(m1 + m * cn * cn)
+
+
+def jacobi(u, m: float, m1: float, K: float | None = None):
+    """sn, cn, dn(u | m) for real u, 0 <= m <= 1, with m1 = 1 - m given separately (so that
+    m close to 1 keeps its digits); vectorised. With the quarter period K given, points
+    within K/2 of K or 3K use sn(K - v) = cd v, cn(K - v) = sqrt(m1) sd v, dn(K - v) =
+    sqrt(m1) nd v: there cn and dn are small, and the AGM's cos(am u) would leave them only
+    absolute accuracy (relative 1e-7 at 1 - m = 1e-18)."""
+    u = np.asarray(u, float)
+    if m1 == 0.0:
+        t = np.tanh(u)
+        s = 1.0 / np.cosh(u)
+        return t, s, s
+    sn, cn, dn = _agm(u, m, m1)
+    if K is None:
+        return sn, cn, dn
+    w = np.mod(u, 4 * K)
+    for centre, sign in ((K, 1.0), (3 * K, -1.0)):
+        near = np.abs(w - centre) < K / 2
+        if np.any(near):
+            s, c, d = _agm(centre - w[near], m, m1)
+            r = math.sqrt(m1)
+            sn[near], cn[near], dn[near] = sign * c / d, sign * r * s / d, r / d
+    return sn, cn, dn
 
 
 @dataclass(frozen=True)
@@ -160,7 +178,7 @@ class Weierstrass:
         with np.errstate(divide="ignore", invalid="ignore"):
             if kind == "rational":
                 return 1 / tau**2, -2 / tau**3
-            sn, cn, dn = jacobi(float(scale) * tau, float(m), max(float(m1), 1e-300))
+            sn, cn, dn = jacobi(float(scale) * tau, float(m), max(float(m1), 1e-300), float(mp.ellipk(m)))
             if kind == "real":
                 lam, e3 = float(scale), float(self.roots[2][2])
                 return e3 + lam**2 / sn**2, -2 * lam**3 * cn * dn / sn**3

@@ -97,6 +97,7 @@ def main(argv=None) -> int:
     tmp.write_text(json.dumps(res, indent=1, sort_keys=True) + "\n")
     tmp.replace(path)
     print(f"written {path.relative_to(ROOT)}")
+    subprocess.run([sys.executable, "-m", "bench.gimbal_integrators"], cwd=ROOT, check=True)
     return 0
 
 

@@ -4,6 +4,7 @@
     gyro campbell MODEL [--set NAME=VALUE]... --out FILE.png [--range LO HI] [--points N]
     gyro stability-map MODEL --x NAME --x-range LO HI --y NAME --y-range LO HI --out FILE.png
     gyro params MODEL
+    gyro simulate gimbal_gyroscope [--set NAME=VALUE]... --t-end T [--points N] [--method NAME] [--json] [--out FILE.png]
 
 Bad input prints one line on stderr naming the parameter and exits with code 2.
 """
@@ -16,6 +17,7 @@ import sys
 import numpy as np
 
 from gyro.models import ParameterError, load
+from gyro.simulate import add_parser as add_simulate
 
 EXIT_USAGE = 2
 METHOD_NAMES = ("formulas", "polyroots", "companion", "default", "reference")  # gyro.ladder.METHODS
@@ -170,6 +172,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("params", help="list a model's parameters with the paper example's values")
     p.add_argument("model")
     p.set_defaults(run=_params)
+    add_simulate(sub)
     return ap
 
 

@@ -16,11 +16,11 @@ import sys
 
 import numpy as np
 
+from gyro import ladder
 from gyro.models import ParameterError, load
 from gyro.simulate import add_parser as add_simulate
 
 EXIT_USAGE = 2
-METHOD_NAMES = ("formulas", "polyroots", "companion", "default", "reference")  # gyro.ladder.METHODS
 
 
 class _Parser(argparse.ArgumentParser):
@@ -51,8 +51,6 @@ def _model_with_equilibrium(name):
 
 
 def _frequencies(args) -> int:
-    from gyro import ladder
-
     model = _model_with_equilibrium(args.model)
     values = model.parameters(_parse_sets(args.set))
     if args.method == "formulas" and "mode_formulas" not in model.meta["functions"]:
@@ -145,7 +143,7 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                    help="parameter value in SI units (phi in degrees); repeat as needed")
     f.add_argument("--json", action="store_true", help="print one JSON object")
-    f.add_argument("--method", default="default", choices=METHOD_NAMES,
+    f.add_argument("--method", default="default", choices=ladder.METHODS,
                    help="rung of the ladder (default: %(default)s; docs/methods.md)")
     f.set_defaults(run=_frequencies)
     c = sub.add_parser("campbell", help="Campbell diagram: frequencies against spin, formulas overlaid")

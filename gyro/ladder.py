@@ -53,10 +53,6 @@ class Spectrum:
     error_estimate: np.ndarray  # relative error bound per frequency
     equilibrium: np.ndarray | None = None  # (sets, equilibrium coordinates)
     route: np.ndarray = field(default=None)  # per set: which rung answered (default only)
-    seconds: float = 0.0  # wall time of the call
-
-    def __len__(self):
-        return self.frequencies.shape[0]
 
 
 # --------------------------------------------------------------------------- batch helpers
@@ -174,18 +170,6 @@ def _sorted(freq, growth, est):
 # --------------------------------------------------------------------------- companion
 
 
-def _companion_matrices(M, D, K):
-    n = M.shape[-1]
-    MinvK = np.linalg.solve(M, K)
-    MinvD = np.linalg.solve(M, D)
-    N = M.shape[0]
-    A = np.zeros((N, 2 * n, 2 * n))
-    A[:, :n, n:] = np.eye(n)
-    A[:, n:, :n] = -MinvK
-    A[:, n:, n:] = -MinvD
-    return A
-
-
 def _pairs(lams: np.ndarray, n: int) -> np.ndarray:
     """One eigenvalue per pair, for each set (gyro.modal.representatives, batched)."""
     return np.array([modal.representatives(l, n) for l in lams])
@@ -195,7 +179,7 @@ def companion(model: Model, P: np.ndarray) -> Spectrum:
     qe, ok = equilibria(model, P)
     M, D, K = operators(model, P, qe)
     n = M.shape[-1]
-    A = _companion_matrices(M, D, K)
+    A = modal.companion_matrix(M, D, K)
     good = ok & _tame(A)
     lam = np.full((P.shape[0], n), np.nan + 0j)
     if good.any():
@@ -387,6 +371,14 @@ def _general(M, D, K):
     return roots, est
 
 
+def _moved(p, rel):
+    """Parameters (last axis; NumPy or a list of mpf) each moved by rel relative, with
+    alternating signs: a fixed, reproducible perturbation of the inputs."""
+    if isinstance(p, np.ndarray):
+        return p * (1 + rel * np.where(np.arange(p.shape[-1]) % 2 == 0, 1.0, -1.0))
+    return [v * (1 + (rel if i % 2 == 0 else -rel)) for i, v in enumerate(p)]
+
+
 def _general_at(model: Model, p: np.ndarray) -> np.ndarray:
     qe, _ = equilibria(model, p[None])
     M, D, K = operators(model, p[None], qe)
@@ -396,14 +388,13 @@ def _general_at(model: Model, p: np.ndarray) -> np.ndarray:
 def _input_rounding(model: Model, p, roots, solve, rel=4 * EPS) -> np.ndarray:
     """The part of each root's error that comes from rounding the inputs: when a root lies
     far below the others (ratio < WIDE), the set is solved again with every parameter
-    moved by `rel` relative (signs fixed, reproducible) and the change of each root,
-    relative, is the estimate; zero otherwise. E.g. at phi = 90 deg, cos(pi phi/180)
+    moved by `rel` relative (_moved: signs fixed, reproducible) and the change of each
+    root, relative, is the estimate; zero otherwise. E.g. at phi = 90 deg, cos(pi phi/180)
     rounds to 6e-17 instead of 0 and omega1 is rounding noise: the estimate says so."""
     mags = np.abs(roots)
     if not np.min(mags) < WIDE * np.max(mags):
         return np.zeros(len(roots))
-    signs = np.where(np.arange(len(p)) % 2 == 0, 1.0, -1.0)
-    moved = np.sort(np.abs(np.asarray(solve(np.asarray(p) * (1 + rel * signs)))))
+    moved = np.sort(np.abs(np.asarray(solve(_moved(np.asarray(p), rel)))))
     order = np.argsort(mags)
     out = np.empty(len(roots))
     out[order] = np.abs(moved - mags[order]) / np.maximum(mags[order], 1e-300)
@@ -413,8 +404,7 @@ def _input_rounding(model: Model, p, roots, solve, rel=4 * EPS) -> np.ndarray:
 def _input_rounding_structured(model: Model, P, w, z, rel=4 * EPS):
     """_input_rounding for the structured rung, batched: the smallest root of each set is
     followed to the moved inputs by one Rayleigh step from its converged vector."""
-    signs = np.where(np.arange(P.shape[1]) % 2 == 0, 1.0, -1.0)
-    Pm = P * (1 + rel * signs)
+    Pm = _moved(P, rel)
     qe, _ = equilibria(model, Pm)
     M, D, K = operators(model, Pm, qe)
     j = np.argmin(w, axis=1)
@@ -566,11 +556,6 @@ def reference(model: Model, P: np.ndarray, dps: int = REFERENCE_DPS) -> Spectrum
     return Spectrum("reference", f, g, e, out[3])
 
 
-def _moved(p, rel):
-    """Every parameter moved by rel relative, with the alternating signs of _input_rounding."""
-    return [v * (1 + (rel if i % 2 == 0 else -rel)) for i, v in enumerate(p)]
-
-
 # --------------------------------------------------------------------------- formulas
 
 
@@ -603,19 +588,13 @@ def formulas(model: Model, P: np.ndarray) -> Spectrum:
 def spectrum(model: Model, params, method: str = "default", tol: float = DEFAULT_TOL) -> Spectrum:
     """Natural frequencies of a batch of parameter sets (rows of `params`, in the order of
     model.param_names) by one method of the ladder."""
-    import time
-
     if method not in METHODS:
         raise ValueError(f"method: unknown {method!r}; known: {', '.join(METHODS)}")
     P = as_batch(model, params)
-    t0 = time.perf_counter()
     if method == "default":
-        out = default(model, P, tol)
-    else:
-        out = {"formulas": formulas, "polyroots": polyroots, "companion": companion,
-               "reference": reference}[method](model, P)
-    out.seconds = time.perf_counter() - t0
-    return out
+        return default(model, P, tol)
+    return {"formulas": formulas, "polyroots": polyroots, "companion": companion,
+            "reference": reference}[method](model, P)
 
 
 # --------------------------------------------------------------------------- stability

@@ -73,13 +73,22 @@ def equilibrium(model: Model, params: np.ndarray, tol: float = 1e-14, max_iter: 
     return np.where(is_angle, _wrap(qe), qe)
 
 
+def companion_matrix(M, D, K):
+    """The first-order matrix [[0, I], [-M^-1 K, -M^-1 D]] of one operator or of a batch
+    (leading axes)."""
+    n = M.shape[-1]
+    A = np.zeros(M.shape[:-2] + (2 * n, 2 * n))
+    A[..., :n, n:] = np.eye(n)
+    A[..., n:, :n] = -np.linalg.solve(M, K)
+    A[..., n:, n:] = -np.linalg.solve(M, D)
+    return A
+
+
 def _companion_eigenvalues(M, D, K):
-    n = M.shape[0]
-    Minv_K = np.linalg.solve(M, K)
-    Minv_D = np.linalg.solve(M, D)
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv_K, -Minv_D]])
-    # balancing evens out the rows of a spectrum spread over five orders of magnitude
-    return sla.eigvals(A, check_finite=True, overwrite_a=True, homogeneous_eigvals=False)
+    # LAPACK balances A (D A D^-1), which evens out the rows of a spectrum spread over five
+    # orders of magnitude, before its QR iteration
+    return sla.eigvals(companion_matrix(M, D, K), check_finite=True, overwrite_a=True,
+                       homogeneous_eigvals=False)
 
 
 def refine(M, D, K, lam: complex, iters: int = 8) -> tuple[complex, float]:

@@ -4,6 +4,8 @@ test (3.3). The emitted code is checked with every model in tests/test_generated
 from __future__ import annotations
 
 import numpy as np
+
+from gyro import load
 import pytest
 import sympy as sp
 
@@ -125,8 +127,7 @@ def _U1pp(values, theta0, H):
     return -K[0, 0], r[0]
 
 
-DEFAULTS = {"A0": 0.02, "B0": 0.015, "C0": 0.0, "A3": 0.01, "P1": 5.0, "eta20": 0.002,
-            "eta30": 0.01, "P": 10.0, "l": 0.02}
+DEFAULTS = load("gimbal_gyroscope").defaults  # the model's illustrative set
 
 
 @pytest.mark.parametrize("theta0, H", [(1.2, 2.0), (1.2, 0.05), (2.4, 2.0), (0.3, 0.5)])

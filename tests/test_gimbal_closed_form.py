@@ -11,10 +11,10 @@ import sympy as sp
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
+from gyro import load
 from gyro.gimbal import ClosedForm, Motion, Weierstrass, integrate, integrals
 
-DEFAULTS = {"A0": 0.02, "B0": 0.015, "C0": 0.0, "A3": 0.01, "P1": 5.0, "eta20": 0.002,
-            "eta30": 0.01, "P": 10.0, "l": 0.02}
+DEFAULTS = load("gimbal_gyroscope").defaults  # the model's illustrative set
 
 b0, b1, b2, b3, b4, P, W = sp.symbols("b0 b1 b2 b3 b4 wp wpd")
 r = sp.Symbol("r", positive=True)  # sqrt(b0)

@@ -10,11 +10,11 @@ import sympy as sp
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from gyro import load
 from gyro.gimbal import (ClosedForm, Motion, U1_second, integrate, kick, mean_drift_paper, section6_case,
                          stationary_motion, theta1_property_a, turning_motion, turning_points)
 
-DEFAULTS = {"A0": 0.02, "B0": 0.015, "C0": 0.0, "A3": 0.01, "P1": 5.0, "eta20": 0.002,
-            "eta30": 0.01, "P": 10.0, "l": 0.02}
+DEFAULTS = load("gimbal_gyroscope").defaults  # the model's illustrative set
 WIDE = (0.3, 0.5, 0.2, 5.0)  # an oscillation wider than pi (one real root of F)
 
 

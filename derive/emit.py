@@ -199,6 +199,13 @@ def input_hash(model_module_file: Path) -> str:
     return h.hexdigest()
 
 
+def _operator_dim(functions: list[Function]) -> int:
+    """Dimension n of the model's operator (M, D, K), when it has one of n >= 2: the C then
+    also gets the root refinement of its quadratic eigenproblem (templates/qep.c.j2)."""
+    n = max((m.rows for fn in functions if fn.name == "operator" for _, m in fn.outputs), default=0)
+    return n if n >= 2 else 0
+
+
 def environment() -> jinja2.Environment:
     return jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(TEMPLATES)),
@@ -224,7 +231,7 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
             emitted[key].append(_printed(fn, temps, reduced, ops, ops_before, printer))
     source = str(module_file.relative_to(ROOT))
     common = dict(model=model.name, title=model.title, paper=model.source, source=source,
-                  digest=digest, versions=tool_versions(), prefix=model.name)
+                  digest=digest, versions=tool_versions(), prefix=model.name, qep_n=_operator_dim(functions))
     files = {
         "casadi_functions.py": ("casadi_functions.py.j2", emitted["casadi"]),
         "numpy_functions.py": ("numpy_functions.py.j2", emitted["numpy"]),

@@ -81,3 +81,57 @@ class BatchFunction:
 @lru_cache(maxsize=None)
 def batch_function(model_name: str, fname: str) -> BatchFunction:
     return BatchFunction(model_name, fname)
+
+
+class QepRefine:
+    """The generated root refinement of the operator's quadratic eigenproblem
+    (templates/qep.c.j2; gyro.ladder._rayleigh_step root by root, in C)."""
+
+    def __init__(self, model_name: str):
+        self._fn = getattr(library(model_name), f"{model_name}_qep_refine_batch")
+        self._fn.restype = None
+
+    def __call__(self, M, D, K, w, z, iters: int, tol: float):
+        """M, D, K (sets, n, n); w (sets, r) and z (sets, r, n) complex: the starts. Returns
+        new arrays (w, z, estimate, ok)."""
+        M, D, K = (np.ascontiguousarray(X, dtype=float) for X in (M, D, K))
+        w = np.array(w, dtype=float, order="C")
+        z = np.array(np.broadcast_to(z, w.shape + (M.shape[-1],)), dtype=complex, order="C")
+        est, ok = np.empty(w.shape), np.empty(w.shape)
+        ptr = ctypes.POINTER(ctypes.c_double)
+        self._fn(ctypes.c_long(w.shape[0]), ctypes.c_long(w.shape[1]), ctypes.c_long(iters),
+                 ctypes.c_double(tol), *[a.ctypes.data_as(ptr) for a in (M, D, K, w, z, est, ok)])
+        return w, z, est, ok.astype(bool)
+
+
+@lru_cache(maxsize=None)
+def qep_refine(model_name: str) -> QepRefine:
+    """The compiled refinement of a model (AttributeError when its C has none)."""
+    return QepRefine(model_name)
+
+
+class QepHermitian:
+    """The generated Hermitian form of a diagonal block of the operator (templates/qep.c.j2;
+    gyro.ladder._hermitian_block's matrix T, in C)."""
+
+    def __init__(self, model_name: str):
+        self._fn = getattr(library(model_name), f"{model_name}_qep_hermitian_batch")
+        self._fn.restype = None
+
+    def __call__(self, M, D, K, idx):
+        """M, D, K (sets, n, n), idx the block's indices. Returns (T, ok): T (sets, 2nb, 2nb)
+        complex Hermitian, ok (sets,) where the block's K and M are positive definite."""
+        M, D, K = (np.ascontiguousarray(X, dtype=float) for X in (M, D, K))
+        idx = np.ascontiguousarray(idx, dtype=np.int64)
+        N, m = M.shape[0], 2 * len(idx)
+        T, ok = np.empty((N, m, m), complex), np.empty(N)
+        ptr = ctypes.POINTER(ctypes.c_double)
+        self._fn(ctypes.c_long(N), ctypes.c_long(len(idx)), idx.ctypes.data_as(ctypes.POINTER(ctypes.c_long)),
+                 *[a.ctypes.data_as(ptr) for a in (M, D, K, T, ok)])
+        return T, ok.astype(bool)
+
+
+@lru_cache(maxsize=None)
+def qep_hermitian(model_name: str) -> QepHermitian:
+    """The compiled Hermitian block form of a model (AttributeError when its C has none)."""
+    return QepHermitian(model_name)

@@ -21,6 +21,8 @@ a relative error estimate for each (docs/methods.md):
   evaluating J. Sets where a block's K is not positive definite, roots leave the real
   axis, two roots merge, or the estimate exceeds the tolerance, escalate by themselves:
   first to the general companion solver with Newton refinement, then to ``reference``.
+  The block forms and the refinement run as the model's generated C (templates/qep.c.j2),
+  set by set and root by root in one call per batch; without a compiler, as NumPy.
 - ``reference``: equilibrium, operator and eigenvalues in arbitrary precision (mpmath, 40
   digits), each root polished by Newton on det J in the same precision; the estimate is
   the size of the last Newton step.
@@ -331,11 +333,19 @@ def _rayleigh_step(M, D, K, w, z):
     return wn, zn, est, ok
 
 
-def _rayleigh(M, D, K, w, z, iters, tol, chunk=256):
-    """_rayleigh_step on every root, in chunks of sets (cache-sized), then further steps
-    only on the roots whose estimate still exceeds tol. Returns (w, z, estimate, ok)."""
+def _rayleigh(model: Model, M, D, K, w, z, iters, tol, chunk=256):
+    """Steps of _rayleigh_step on every root until its estimate is <= tol (at most `iters`).
+    Compiled: the model's generated refinement (templates/qep.c.j2), root by root. Without
+    a compiler: _rayleigh_step on every root, in chunks of sets (cache-sized), then further
+    steps only on the roots whose estimate still exceeds tol. Returns (w, z, estimate, ok)."""
+    from gyro.cbackend import CompilerUnavailable, qep_refine
+
+    try:
+        return qep_refine(model.name)(M, D, K, w, z, iters, tol)
+    except (CompilerUnavailable, AttributeError):
+        pass
     N = M.shape[0]
-    w, z = w.copy(), np.array(z, dtype=complex)
+    w, z = w.copy(), np.array(np.broadcast_to(z, w.shape + (M.shape[-1],)), dtype=complex)
     est = np.full(w.shape, np.inf)
     ok = np.zeros(w.shape, bool)
     for s in range(0, N, chunk):
@@ -410,11 +420,43 @@ def _input_rounding_structured(model: Model, P, w, z, rel=4 * EPS):
     j = np.argmin(w, axis=1)
     rows = np.arange(len(w))
     w_small = w[rows, j]
-    wm, _, _, ok = _rayleigh_step(M, D, K, w_small[:, None], z[rows, j][:, None])
+    wm, _, _, ok = _rayleigh(model, M, D, K, w_small[:, None], z[rows, j][:, None], 1, 0.0)
     change = np.where(ok[:, 0], np.abs(wm[:, 0] - w_small) / w_small, np.inf)
     out = np.zeros(w.shape)
     out[rows, j] = change
     return out
+
+
+def _block_starts(model: Model, M, D, K, good):
+    """Which sets take the Hermitian path (K > 0 and M > 0 in every diagonal block, with a
+    margin) and, for those, the block problems' frequencies (sets taken, n): the starts of
+    the refinement. Compiled: the model's generated block form (templates/qep.c.j2), whose
+    Cholesky pivots must exceed 1e3 eps; without a compiler: _hermitian_block, after the
+    least eigenvalue of each scaled K block is found above 1e3 eps."""
+    from gyro.cbackend import CompilerUnavailable, qep_hermitian
+
+    blocks = _blocks(model)
+    try:
+        forms = [qep_hermitian(model.name)(M, D, K, b) for b in blocks]
+    except (CompilerUnavailable, AttributeError):
+        forms = None
+    if forms is not None:
+        herm = good & np.all([ok for _, ok in forms], axis=0)
+        take = slice(None) if herm.all() else np.flatnonzero(herm)  # no copy when all take it
+        mu = [np.linalg.eigvalsh(T[take])[:, len(b):] for (T, _), b in zip(forms, blocks)]
+        return herm, 1 / np.concatenate(mu, axis=1)  # mu ascending: w descending per block
+    N = M.shape[0]
+    kmin = np.full(N, -np.inf)
+    dK = np.einsum("bii->bi", K)
+    scalable = good & np.all(dK > 0, axis=1) & np.all(np.einsum("bii->bi", M) > 0, axis=1)
+    if scalable.any():
+        Ks = K[scalable] / np.sqrt(dK[scalable][:, :, None] * dK[scalable][:, None, :])
+        kmin[scalable] = np.min([np.linalg.eigvalsh(Ks[:, b][:, :, b])[:, 0] for b in blocks], axis=0)
+    herm = scalable & (kmin > 1e3 * EPS)
+    h = np.flatnonzero(herm)
+    Mh, Dh, Kh = M[h], D[h], K[h]
+    return herm, np.concatenate([_hermitian_block(Mh[:, b][:, :, b], Dh[:, b][:, :, b], Kh[:, b][:, :, b])
+                                 for b in blocks], axis=1)
 
 
 def default(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
@@ -427,22 +469,12 @@ def default(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
     est = np.full((N, n), np.inf)
     route = np.array(["structured"] * N, dtype=object)
     good = ok & _tame(M) & _tame(D) & _tame(K)
-    # K > 0 in every block: the Hermitian path applies (checked per set: LAPACK's Cholesky
-    # fails for the whole batch otherwise)
-    blocks = _blocks(model)
-    kmin = np.full(N, -np.inf)
-    dK = np.einsum("bii->bi", K)
-    scalable = good & np.all(dK > 0, axis=1) & np.all(np.einsum("bii->bi", M) > 0, axis=1)
-    if scalable.any():
-        Ks = K[scalable] / np.sqrt(dK[scalable][:, :, None] * dK[scalable][:, None, :])
-        kmin[scalable] = np.min([np.linalg.eigvalsh(Ks[:, b][:, :, b])[:, 0] for b in blocks], axis=0)
-    herm = scalable & (kmin > 1e3 * EPS)
+    herm, w0 = _block_starts(model, M, D, K, good)
     h = np.flatnonzero(herm)
     if h.size:
-        Mh, Dh, Kh = M[h], D[h], K[h]
-        w0 = np.concatenate([_hermitian_block(Mh[:, b][:, :, b], Dh[:, b][:, :, b], Kh[:, b][:, :, b])
-                             for b in blocks], axis=1)
-        w, z, e, fine = _rayleigh(Mh, Dh, Kh, w0, _start_vectors(h.size, n, n), 3, tol)
+        take = slice(None) if h.size == N else h
+        Mh, Dh, Kh = M[take], D[take], K[take]
+        w, z, e, fine = _rayleigh(model, Mh, Dh, Kh, w0, _start_vectors(h.size, n, n), 3, tol)
         ws_sorted = np.sort(w, axis=1)
         distinct = np.all(np.diff(ws_sorted, axis=1) > 1e-8 * ws_sorted[:, 1:], axis=1)
         # a root far below the others (omega1 -> 0 toward the pole or as u -> 0) carries the

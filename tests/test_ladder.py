@@ -232,6 +232,58 @@ def test_batch_equals_single_sets():
         np.testing.assert_allclose(one.frequencies[0], batch.frequencies[k], rtol=1e-14)
 
 
+def _without_compiler(monkeypatch) -> list:
+    """The default method's NumPy path: the generated C kernels reported unavailable. The
+    returned list records each refusal."""
+    from gyro import cbackend
+
+    refused = []
+
+    def unavailable(name):
+        refused.append(name)
+        raise cbackend.CompilerUnavailable("test: NumPy path")
+
+    monkeypatch.setattr(cbackend, "qep_refine", unavailable)
+    monkeypatch.setattr(cbackend, "qep_hermitian", unavailable)
+    return refused
+
+
+def test_compiled_kernels_agree_with_the_numpy_path(monkeypatch):
+    """The generated C (templates/qep.c.j2) and the NumPy path of the default method are the
+    same algorithm: on the edges above they take the same route, and their frequencies agree
+    to far below the tolerance (their LU factorisations round differently, hence 1e-12)."""
+    P = np.array([params(**over) for over in EDGES.values()])
+    compiled = ladder.spectrum(MODEL, P, "default")
+    refused = _without_compiler(monkeypatch)
+    numpy_path = ladder.spectrum(MODEL, P, "default")
+    assert len(refused) >= 2  # both kernels were asked for and the NumPy path answered
+    assert list(compiled.route) == list(numpy_path.route)
+    np.testing.assert_allclose(compiled.frequencies, numpy_path.frequencies, rtol=1e-12)
+    np.testing.assert_allclose(compiled.growth, numpy_path.growth, rtol=1e-12, atol=1e-12)
+    assert np.all(numpy_path.error_estimate <= TOL) and np.all(compiled.error_estimate <= TOL)
+
+
+def test_refinement_steps_agree_root_by_root():
+    """One step of the C refinement is one step of _rayleigh_step: same shift, same vector,
+    the same new frequency, vector (up to rounding) and estimate."""
+    from gyro.cbackend import qep_refine
+
+    P = np.array([params(), params(phi=60.0), params(H=0.1)])
+    qe, _ = ladder.equilibria(MODEL, P)
+    M, D, K = ladder.operators(MODEL, P, qe)
+    n = M.shape[-1]
+    rng = np.random.default_rng(1)
+    w0 = np.sort(np.abs(ladder.spectrum(MODEL, P, "companion").frequencies), axis=1)
+    w0 = w0 * (1 + 1e-4 * rng.standard_normal(w0.shape))
+    z0 = ladder._start_vectors(len(P), n, n)
+    wc, zc, ec, okc = qep_refine(MODEL.name)(M, D, K, w0, z0, 1, 0.0)
+    wn, zn, en, okn = ladder._rayleigh_step(M, D, K, w0, np.array(z0))
+    assert okc.all() and okn.all()
+    np.testing.assert_allclose(wc, wn, rtol=1e-12)
+    np.testing.assert_allclose(np.abs(np.sum(zc.conj() * zn, axis=-1)), 1.0, rtol=1e-10)
+    np.testing.assert_allclose(ec, en, rtol=1e-3)
+
+
 def _cli(*args):
     return subprocess.run([sys.executable, "-m", "gyro", *args], capture_output=True, text=True)
 

@@ -206,6 +206,16 @@ def _operator_dim(functions: list[Function]) -> int:
     return n if n >= 2 else 0
 
 
+def _mode_select(functions: list[Function]) -> dict | None:
+    """Shape of the model's mode formulas (modes, candidates, parameters), when it has them:
+    the C then also selects and sorts them (templates/mode_select.c.j2)."""
+    for fn in functions:
+        if fn.name == "mode_formulas":
+            omega = dict(fn.outputs)["omega"]
+            return {"modes": omega.rows, "cands": omega.cols, "n_params": len(fn.inputs[0][1])}
+    return None
+
+
 def environment() -> jinja2.Environment:
     return jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(TEMPLATES)),
@@ -231,7 +241,8 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
             emitted[key].append(_printed(fn, temps, reduced, ops, ops_before, printer))
     source = str(module_file.relative_to(ROOT))
     common = dict(model=model.name, title=model.title, paper=model.source, source=source,
-                  digest=digest, versions=tool_versions(), prefix=model.name, qep_n=_operator_dim(functions))
+                  digest=digest, versions=tool_versions(), prefix=model.name, qep_n=_operator_dim(functions),
+                  select=_mode_select(functions))
     files = {
         "casadi_functions.py": ("casadi_functions.py.j2", emitted["casadi"]),
         "numpy_functions.py": ("numpy_functions.py.j2", emitted["numpy"]),

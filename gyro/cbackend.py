@@ -135,3 +135,27 @@ class QepHermitian:
 def qep_hermitian(model_name: str) -> QepHermitian:
     """The compiled Hermitian block form of a model (AttributeError when its C has none)."""
     return QepHermitian(model_name)
+
+
+class ModeFormulasSelected:
+    """The generated selection and sort of the mode formulas (templates/mode_select.c.j2;
+    gyro.ladder.formulas in one pass over the batch)."""
+
+    def __init__(self, model_name: str):
+        self._fn = getattr(library(model_name), f"{model_name}_mode_formulas_selected_batch")
+        self._fn.restype = None
+        self.modes = len(load(model_name).meta["mode_formulas"])
+
+    def __call__(self, P):
+        """P (sets, parameters). Returns (frequencies, estimates), each (sets, modes)."""
+        P = np.ascontiguousarray(P, dtype=float)
+        f, e = np.empty((P.shape[0], self.modes)), np.empty((P.shape[0], self.modes))
+        ptr = ctypes.POINTER(ctypes.c_double)
+        self._fn(ctypes.c_long(P.shape[0]), *[a.ctypes.data_as(ptr) for a in (P, f, e)])
+        return f, e
+
+
+@lru_cache(maxsize=None)
+def mode_formulas_selected(model_name: str) -> ModeFormulasSelected:
+    """The compiled selection of a model's mode formulas (AttributeError when it has none)."""
+    return ModeFormulasSelected(model_name)

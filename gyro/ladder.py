@@ -592,17 +592,27 @@ def reference(model: Model, P: np.ndarray, dps: int = REFERENCE_DPS) -> Spectrum
 
 
 def formulas(model: Model, P: np.ndarray) -> Spectrum:
-    """The model's mode formulas (metadata 'mode_formulas'), compiled C over the batch: for
-    each mode, among its candidate formulas the one whose own error estimate is smallest."""
+    """The model's mode formulas (metadata 'mode_formulas') over the batch: for each mode,
+    among its candidate formulas the one whose own error estimate is smallest, sorted by
+    frequency. Compiled: one pass of the generated C (templates/mode_select.c.j2); without a
+    compiler, NumPy."""
+    from gyro.cbackend import CompilerUnavailable, mode_formulas_selected
+
+    try:
+        with np.errstate(all="ignore"):
+            f, e = mode_formulas_selected(model.name)(P)
+        return Spectrum("formulas", f, np.zeros_like(f), e)
+    except (CompilerUnavailable, AttributeError):
+        pass
     if P.shape[0] > FORMULA_CHUNK:  # cache-sized pieces: the selection is memory-bound
         parts = [formulas(model, P[s:s + FORMULA_CHUNK]) for s in range(0, P.shape[0], FORMULA_CHUNK)]
         f, e = (np.concatenate([getattr(x, a) for x in parts]) for a in ("frequencies", "error_estimate"))
         return Spectrum("formulas", f, np.zeros_like(f), e)
     with np.errstate(all="ignore"):
-        omega, estimate = _fn(model, "mode_formulas")(P)
+        omega, estimate = getattr(model.numpy, "mode_formulas")(P)
     N = P.shape[0]
     n = len(model.meta["mode_formulas"])
-    omega, estimate = omega.reshape(N, n, -1), estimate.reshape(N, n, -1)
+    omega, estimate = np.reshape(omega, (N, n, -1)), np.reshape(estimate, (N, n, -1))
     f, e = omega[..., 0], estimate[..., 0]
     for j in range(1, omega.shape[2]):
         better = estimate[..., j] < e

@@ -245,6 +245,7 @@ def _without_compiler(monkeypatch) -> list:
 
     monkeypatch.setattr(cbackend, "qep_refine", unavailable)
     monkeypatch.setattr(cbackend, "qep_hermitian", unavailable)
+    monkeypatch.setattr(cbackend, "mode_formulas_selected", unavailable)
     return refused
 
 
@@ -261,6 +262,23 @@ def test_compiled_kernels_agree_with_the_numpy_path(monkeypatch):
     np.testing.assert_allclose(compiled.frequencies, numpy_path.frequencies, rtol=1e-12)
     np.testing.assert_allclose(compiled.growth, numpy_path.growth, rtol=1e-12, atol=1e-12)
     assert np.all(numpy_path.error_estimate <= TOL) and np.all(compiled.error_estimate <= TOL)
+
+
+def test_compiled_formula_selection_agrees_with_numpy(monkeypatch):
+    """The generated selection and sort of the mode formulas (templates/mode_select.c.j2)
+    against the NumPy path: over the edges, the pole itself (omega1 = 0 to rounding: outside
+    its formula's domain) and u = 0, where formulas divide 0 by 0. The same candidates, the
+    same order, the same domain verdicts; values to rounding (C and NumPy evaluate the
+    formulas' expressions with different elementary functions)."""
+    P = np.array([params(**over) for over in EDGES.values()] + [params(phi=90.0), params(u=0.0)])
+    compiled = ladder.spectrum(MODEL, P, "formulas")
+    refused = _without_compiler(monkeypatch)
+    numpy_path = ladder.spectrum(MODEL, P, "formulas")
+    assert refused == ["torsion_gyrocompass"]
+    assert not np.all(np.isfinite(numpy_path.error_estimate))  # the domain check is exercised
+    np.testing.assert_array_equal(np.isinf(compiled.error_estimate), np.isinf(numpy_path.error_estimate))
+    np.testing.assert_allclose(compiled.frequencies, numpy_path.frequencies, rtol=1e-13, atol=1e-300)
+    np.testing.assert_allclose(compiled.error_estimate, numpy_path.error_estimate, rtol=1e-12)
 
 
 def test_refinement_steps_agree_root_by_root():

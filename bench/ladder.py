@@ -22,7 +22,7 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from gyro import campbell, ladder, load  # noqa: E402
+from gyro import campbell, cbackend, ladder, load  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"
@@ -30,6 +30,8 @@ MODEL = load("torsion_gyrocompass")
 GOALS = {"default_sets_per_s": 20000, "default_rel_error": 1e-10, "formulas_sets_per_s": 5e6,
          "reference_s_per_set": 1.0}
 BATCH = {"formulas": 1_000_000, "polyroots": 300, "companion": 20000, "default": 20000}
+# the compiled rungs again on their NumPy paths (a machine without gcc): same algorithm
+NUMPY_PATH = {"default, NumPy path": "default", "formulas, NumPy path": "formulas"}
 SPREAD_POINTS = 9
 
 
@@ -55,6 +57,9 @@ def rel_errors(s: ladder.Spectrum, r: ladder.Spectrum) -> np.ndarray:
 
 
 def time_per_set(method: str, P: np.ndarray) -> float:
+    if method in NUMPY_PATH:
+        with cbackend.disabled():
+            return time_per_set(NUMPY_PATH[method], P)
     n = BATCH[method]
     big = np.tile(P, (int(np.ceil(n / len(P))), 1))[:n]
     ladder.spectrum(MODEL, big[:4], method)  # warm: compile, imports
@@ -72,9 +77,9 @@ def main() -> int:
         "python": platform.python_version(), "processor": platform.machine(), "threads": 1}}
     all_sets = np.concatenate(list(spreads().values()))
     print("timing each method over a batch (one core) ...", flush=True)
-    timing = {m: time_per_set(m, all_sets) for m in BATCH}
+    timing = {m: time_per_set(m, all_sets) for m in [*BATCH, *NUMPY_PATH]}
     for m, t in timing.items():
-        print(f"  {m:10s} {t * 1e6:10.3f} us per set ({1 / t:,.0f} sets/s)", flush=True)
+        print(f"  {m:21s} {t * 1e6:10.3f} us per set ({1 / t:,.0f} sets/s)", flush=True)
     ref_times = []
     for name, P in spreads().items():
         print(f"{name}: reference on {len(P)} sets ...", flush=True)
@@ -82,9 +87,15 @@ def main() -> int:
         r = ladder.spectrum(MODEL, P, "reference")
         ref_times.append((time.perf_counter() - t0) / len(P))
         entry = {"sets": len(P), "methods": {}}
-        for m in ("formulas", "polyroots", "companion", "default", "reference"):
-            s = r if m == "reference" else ladder.spectrum(MODEL, P, m)
-            if m == "formulas":  # approximate modes: distance to the nearest exact root
+        for m in [*ladder.METHODS, *NUMPY_PATH]:
+            if m == "reference":
+                s = r
+            elif m in NUMPY_PATH:
+                with cbackend.disabled():
+                    s = ladder.spectrum(MODEL, P, NUMPY_PATH[m])
+            else:
+                s = ladder.spectrum(MODEL, P, m)
+            if s.method == "formulas":  # approximate modes: distance to the nearest exact root
                 err = campbell.nearest_error(s.frequencies, r.frequencies)
             elif m == "reference":
                 err = s.error_estimate
@@ -96,7 +107,7 @@ def main() -> int:
                 "max_rel_error": float(np.nanmax(err)),
                 "estimate_bounds_error": bound_held,
                 "routes": (sorted(set(s.route)) if s.route is not None else None)}
-            print(f"  {m:10s} max error {np.nanmax(err):9.2e}  estimate bounds it: {bound_held}", flush=True)
+            print(f"  {m:21s} max error {np.nanmax(err):9.2e}  estimate bounds it: {bound_held}", flush=True)
         out["spreads"][name] = entry
     timing["reference"] = float(np.mean(ref_times))
     out["seconds_per_set"] = timing
@@ -109,8 +120,13 @@ def main() -> int:
     print("Campbell diagram and stability map ...", flush=True)
     data = campbell.sweep(MODEL, MODEL.defaults, 0.1, 10.0, 240)
     campbell.plot(MODEL, data, RESULTS / "campbell.png")
-    grid = campbell.stability_grid(MODEL, MODEL.defaults, "l2", (-0.4, 0.4), "Kgamma", (0.5, 200.0), 70)
-    campbell.plot_stability(MODEL, grid, RESULTS / "stability_map.png")
+    # the rotor centre's height against the angular momentum: the boundary m l2 + M l1 = 0
+    # (l_c = 0) from the derivation, and how H slows the growth it can reach (H^-1/2)
+    d = MODEL.defaults
+    grid = campbell.stability_grid(MODEL, d, "l2", (-0.5, 0.3), "H", (0.01, 10.0), 70, ylog=True)
+    lc0 = -d["M"] * d["l1"] / d["m"]
+    campbell.plot_stability(MODEL, grid, RESULTS / "stability_map.png",
+                            lines=[([lc0, lc0], [0.01, 10.0], "l_c = 0 (m l2 + M l1 = 0)")])
     out["campbell_shaded_fraction"] = data["shaded_fraction"]
     path = RESULTS / "ladder.json"
     path.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
@@ -130,7 +146,8 @@ def chart(out: dict) -> None:
 
     style = {"formulas": ("tab:blue", "s"), "polyroots": ("tab:red", "v"),
              "companion": ("tab:orange", "^"), "default": ("tab:green", "o"),
-             "reference": ("tab:purple", "D")}
+             "reference": ("tab:purple", "D"), "default, NumPy path": ("tab:green", "o"),
+             "formulas, NumPy path": ("tab:blue", "s")}
     fig, axes = plt.subplots(2, 2, figsize=(11, 8.5), sharex=True, sharey=True, layout="constrained")
     floor = 1e-17  # an error of exactly zero is drawn here
     for ax, (name, entry) in zip(axes.ravel(), out["spreads"].items()):
@@ -139,8 +156,9 @@ def chart(out: dict) -> None:
             errs = np.maximum(np.nan_to_num(entry["methods"][m]["max_rel_error_per_frequency"], nan=10.0), floor)
             errs = np.minimum(errs, 10.0)
             jitter = t * np.exp(np.linspace(-0.12, 0.12, len(errs)))
-            ax.scatter(jitter, errs, color=color, marker=marker, s=22, alpha=0.8,
-                       label=m if ax is axes[0, 0] else None)
+            hollow = m in NUMPY_PATH  # the same algorithm without the generated C
+            ax.scatter(jitter, errs, marker=marker, s=22, alpha=0.8, label=m if ax is axes[0, 0] else None,
+                       facecolors="none" if hollow else color, edgecolors=color)
             ax.annotate("omega1", (jitter[0], errs[0]), fontsize=6, color=color,
                         xytext=(3, 3), textcoords="offset points")
         ax.axhline(1e-10, color="k", lw=0.7, ls="--")

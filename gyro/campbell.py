@@ -114,41 +114,67 @@ def plot(model: Model, data: dict, out: Path):
     plt.close(fig)
 
 
-def stability_grid(model: Model, values: dict, xname, xrange, yname, yrange, points, progress=False):
-    xs = np.linspace(*xrange, points)
-    ys = np.linspace(*yrange, points)
+def stability_grid(model: Model, values: dict, xname, xrange, yname, yrange, points, progress=False,
+                   xlog=False, ylog=False):
+    """Stability over a grid of two parameters (log-spaced where asked), by the default method."""
+    xs = (np.geomspace if xlog else np.linspace)(*xrange, points)
+    ys = (np.geomspace if ylog else np.linspace)(*yrange, points)
     X, Y = np.meshgrid(xs, ys)
     P = np.tile(model.vector(values), (X.size, 1))
     P[:, model.param_names.index(xname)] = X.ravel()
     P[:, model.param_names.index(yname)] = Y.ravel()
     spec = batch_default(model, P, progress, desc="stability map")
     st = ladder.classify(spec)
-    return {"x": xs, "y": ys, "xname": xname, "yname": yname,
-            "label": st.label.reshape(X.shape), "growth": st.growth_rate.reshape(X.shape)}
+    return {"x": xs, "y": ys, "xname": xname, "yname": yname, "xlog": xlog, "ylog": ylog,
+            "label": st.label.reshape(X.shape), "growth": st.growth_rate.reshape(X.shape),
+            "unstable_roots": st.unstable_roots.reshape(X.shape), "slowest": st.slowest_growth.reshape(X.shape)}
 
 
-def plot_stability(model: Model, grid: dict, out: Path):
+def plot_stability(model: Model, grid: dict, out: Path, lines=()):
+    """The stability map: regions by Poincare's degree of instability (stable, marginal, one
+    growing pair, two or more), solid contours of the fastest growth rate and dashed ones of
+    the slowest where two or more pairs grow (a growth that gyroscopic coupling slows down
+    shows there, not in the fastest). `lines`: (xs, ys, label) curves to overlay, such as an
+    analytic stability boundary."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.colors import ListedColormap
 
-    code = np.select([grid["label"] == "stable", grid["label"] == "marginal"], [0, 1], 2)
-    fig, ax = plt.subplots(figsize=(7, 5.5), layout="constrained")
+    degree = np.minimum(grid["unstable_roots"], 2)
+    code = np.where(grid["label"] == "marginal", 1, np.where(degree > 0, degree + 1, 0))
+    colors = ["#cfe8cf", "#f3e3a1", "#f2b8b0", "#d9786c"]
+    names = ["stable", "marginal", "unstable: one growing pair", "unstable: two or more"]
+    fig, ax = plt.subplots(figsize=(7.5, 5.8), layout="constrained")
     units = {p.name: p.unit for p in model.params}
-    ax.pcolormesh(grid["x"], grid["y"], code, cmap=ListedColormap(["#cfe8cf", "#f3e3a1", "#f2b8b0"]),
-                  vmin=-0.5, vmax=2.5, shading="nearest")
-    g = np.where(grid["growth"] > 0, grid["growth"], np.nan)
-    if np.any(np.isfinite(g)):
-        cs = ax.contour(grid["x"], grid["y"], np.log10(g), colors="k", linewidths=0.6)
-        ax.clabel(cs, fmt=lambda v: f"{10**v:.2g}/s", fontsize=7)
-    for name, color in (("stable", "#cfe8cf"), ("marginal", "#f3e3a1"), ("unstable", "#f2b8b0")):
-        ax.fill_between([], [], color=color, label=name)
+    ax.pcolormesh(grid["x"], grid["y"], code, cmap=ListedColormap(colors), vmin=-0.5, vmax=3.5,
+                  shading="nearest")
+    for key, style, where in (("growth", "-", grid["unstable_roots"] > 0),
+                              ("slowest", "--", grid["unstable_roots"] > 1)):
+        g = np.where(where & (grid[key] > 0), grid[key], np.nan)
+        if np.sum(np.isfinite(g)) > 3 and np.nanmax(g) > np.nanmin(g):
+            lo, hi = np.log10(np.nanmin(g)), np.log10(np.nanmax(g))
+            step = 0.5 if hi - lo > 1.5 else 0.1  # half decades, or tenths of one
+            levels = np.arange(np.ceil(lo / step) * step, hi, step)
+            if levels.size == 0:
+                continue
+            cs = ax.contour(grid["x"], grid["y"], np.log10(g), levels=levels, colors="k", linewidths=0.6,
+                            linestyles=style)
+            ax.clabel(cs, fmt=lambda v: f"{10**v:.2g}/s", fontsize=7)
+    for xs, ys, label in lines:
+        ax.plot(xs, ys, color="tab:blue", lw=1.2, ls=":", label=label)
+    for code_, (name, color) in enumerate(zip(names, colors)):
+        if np.any(code == code_):
+            ax.fill_between([], [], color=color, label=name)
+    ax.set_xscale("log" if grid.get("xlog") else "linear")
+    ax.set_yscale("log" if grid.get("ylog") else "linear")
+    ax.set_xlim(grid["x"][0], grid["x"][-1])
+    ax.set_ylim(grid["y"][0], grid["y"][-1])
     ax.set_xlabel(f"{grid['xname']} [{units[grid['xname']]}]")
     ax.set_ylabel(f"{grid['yname']} [{units[grid['yname']]}]")
-    ax.set_title(f"Stability of the equilibrium: {model.meta['title']}\n(contours: growth rate of the unstable root)",
-                 fontsize=9)
+    ax.set_title(f"Stability of the equilibrium: {model.meta['title']}\n(contours: growth rate, "
+                 "solid the fastest, dashed the slowest growing root)", fontsize=9)
     ax.legend(fontsize=8, loc="best")
     _save(fig, out)
     plt.close(fig)

@@ -15,6 +15,7 @@ import platform
 import shutil
 import subprocess
 import tempfile
+from contextlib import contextmanager
 from functools import lru_cache
 from pathlib import Path
 
@@ -27,6 +28,37 @@ FLAGS = ("-O3", "-march=native", "-std=c99", "-fPIC", "-shared")
 
 class CompilerUnavailable(RuntimeError):
     pass
+
+
+_disabled = 0
+
+
+@contextmanager
+def disabled():
+    """Within this block every entry point reports CompilerUnavailable, so the runtime takes
+    its NumPy paths (as on a machine without gcc): for benchmarks and comparisons."""
+    global _disabled
+    _disabled += 1
+    try:
+        yield
+    finally:
+        _disabled -= 1
+
+
+def _available() -> None:
+    if _disabled:
+        raise CompilerUnavailable("compiled code disabled (gyro.cbackend.disabled)")
+
+
+@lru_cache(maxsize=None)
+def _cached(cls, *args):
+    return cls(*args)
+
+
+def _built(cls, *args):
+    """One instance per (class, arguments), built on first use, unless disabled()."""
+    _available()
+    return _cached(cls, *args)
 
 
 def cache_dir() -> Path:
@@ -78,9 +110,8 @@ class BatchFunction:
         return [o.reshape((n, r) if c == 1 else (n, r, c)) for o, (r, c) in zip(outs, self.out_shapes)]
 
 
-@lru_cache(maxsize=None)
 def batch_function(model_name: str, fname: str) -> BatchFunction:
-    return BatchFunction(model_name, fname)
+    return _built(BatchFunction, model_name, fname)
 
 
 class QepRefine:
@@ -104,10 +135,9 @@ class QepRefine:
         return w, z, est, ok.astype(bool)
 
 
-@lru_cache(maxsize=None)
 def qep_refine(model_name: str) -> QepRefine:
     """The compiled refinement of a model (AttributeError when its C has none)."""
-    return QepRefine(model_name)
+    return _built(QepRefine, model_name)
 
 
 class QepHermitian:
@@ -131,10 +161,9 @@ class QepHermitian:
         return T, ok.astype(bool)
 
 
-@lru_cache(maxsize=None)
 def qep_hermitian(model_name: str) -> QepHermitian:
     """The compiled Hermitian block form of a model (AttributeError when its C has none)."""
-    return QepHermitian(model_name)
+    return _built(QepHermitian, model_name)
 
 
 class ModeFormulasSelected:
@@ -155,7 +184,6 @@ class ModeFormulasSelected:
         return f, e
 
 
-@lru_cache(maxsize=None)
 def mode_formulas_selected(model_name: str) -> ModeFormulasSelected:
     """The compiled selection of a model's mode formulas (AttributeError when it has none)."""
-    return ModeFormulasSelected(model_name)
+    return _built(ModeFormulasSelected, model_name)

@@ -2,7 +2,7 @@
 
     gyro frequencies MODEL [--set NAME=VALUE]... [--method NAME] [--json]
     gyro campbell MODEL [--set NAME=VALUE]... --out FILE.png [--range LO HI] [--points N]
-    gyro stability-map MODEL --x NAME --x-range LO HI --y NAME --y-range LO HI --out FILE.png
+    gyro stability-map MODEL --x NAME --x-range LO HI --y NAME --y-range LO HI [--x-log] [--y-log] --out FILE.png
     gyro params MODEL
     gyro simulate gimbal_gyroscope [--set NAME=VALUE]... --t-end T [--points N] [--method NAME] [--json] [--out FILE.png]
 
@@ -71,7 +71,8 @@ def _frequencies(args) -> int:
             "eigenvalues_re": [float(g) for g in growth],
             "method": args.method,
             "error_estimate": [float(e) if np.isfinite(e) else None for e in est],
-            "stability": {"class": str(stab.label[0]), "growth_rate": float(stab.growth_rate[0])},
+            "stability": {"class": str(stab.label[0]), "growth_rate": float(stab.growth_rate[0]),
+                          "unstable_roots": int(stab.unstable_roots[0])},
         }, allow_nan=False))
         return 0
     print(f"{model.meta['title']} ({model.name})")
@@ -82,7 +83,8 @@ def _frequencies(args) -> int:
         period = 2 * np.pi / w if w > 0 else float("inf")
         print(f"{i:>4} {w:>16.9g} {w / (2 * np.pi):>14.6g} {period:>14.6g} {e:>14.2g}")
     label = stab.label[0]
-    print(f"equilibrium: {label}" + (f", growth rate {stab.growth_rate[0]:.6g} 1/s" if label == "unstable" else ""))
+    print(f"equilibrium: {label}" + (f", {stab.unstable_roots[0]} growing root(s), the fastest at "
+                                     f"{stab.growth_rate[0]:.6g} 1/s" if label == "unstable" else ""))
     return 0
 
 
@@ -109,18 +111,21 @@ def _stability_map(args) -> int:
 
     model = _model_with_equilibrium(args.model)
     values = model.parameters(_parse_sets(args.set))
-    for axis, name, (lo, hi) in (("--x", args.x, args.x_range), ("--y", args.y, args.y_range)):
+    for axis, name, (lo, hi), log in (("--x", args.x, args.x_range, args.x_log),
+                                      ("--y", args.y, args.y_range, args.y_log)):
         if name not in model.param_names:
             raise ParameterError(f"{axis} {name!r}: unknown parameter; known: {' '.join(model.param_names)}")
         if not lo < hi:
             raise ParameterError(f"{axis}-range: need LO < HI, got {lo} {hi}")
+        if log and not lo > 0:
+            raise ParameterError(f"{axis}-range: {axis}-log needs 0 < LO, got {lo}")
         for v in (lo, hi):
             model.parameters({name: v})  # validates the ends of the range
     if args.points < 2:
         raise ParameterError(f"--points: need at least 2, got {args.points}")
     out = campbell.check_output(args.out)
     grid = campbell.stability_grid(model, values, args.x, args.x_range, args.y, args.y_range,
-                                   args.points, progress=not args.quiet)
+                                   args.points, progress=not args.quiet, xlog=args.x_log, ylog=args.y_log)
     campbell.plot_stability(model, grid, out)
     counts = {k: int(np.sum(grid["label"] == k)) for k in ("stable", "marginal", "unstable")}
     print(f"gyro: wrote {out} ({', '.join(f'{v} {k}' for k, v in counts.items())})")
@@ -164,6 +169,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--y", required=True, metavar="NAME")
     s.add_argument("--y-range", nargs=2, type=float, required=True, metavar=("LO", "HI"))
     s.add_argument("--points", type=int, default=60, help="grid points per axis (default: 60)")
+    s.add_argument("--x-log", action="store_true", help="log-spaced x axis (needs 0 < LO)")
+    s.add_argument("--y-log", action="store_true", help="log-spaced y axis (needs 0 < LO)")
     s.add_argument("--out", required=True, metavar="FILE.png")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.set_defaults(run=_stability_map)

@@ -649,6 +649,8 @@ class Stability:
 
     label: np.ndarray  # (sets,) str
     growth_rate: np.ndarray  # (sets,) largest real part, 1/s (0 when stable)
+    unstable_roots: np.ndarray  # (sets,) int: eigenvalue pairs that grow (Poincare's degree of instability)
+    slowest_growth: np.ndarray  # (sets,) smallest growing real part, 1/s (0 when stable)
 
 
 def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
@@ -665,4 +667,5 @@ def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
     neutral = np.nan_to_num(spec.error_estimate, nan=np.inf) >= 1
     label = np.where(growing.any(axis=1), "unstable", np.where(neutral.any(axis=1), "marginal", "stable"))
     rate = np.where(growing, spec.growth, 0.0).max(axis=1)
-    return Stability(label.astype(object), rate)
+    slowest = np.where(growing, spec.growth, np.inf).min(axis=1)
+    return Stability(label.astype(object), rate, growing.sum(axis=1), np.where(np.isfinite(slowest), slowest, 0.0))

@@ -204,6 +204,23 @@ def test_stability_across_Kgamma():
     assert np.all(c.growth_rate > 0)
 
 
+def test_top_heavy_degree_of_instability_and_gyroscopic_slowing():
+    """Top-heavy (m l2 + M l1 < 0): two pairs grow. The tilt about the spin axis, which the
+    rotor's momentum does not reach, grows at a rate independent of H; the tilt about the
+    east axis is coupled by H to the azimuth, whose stiffness is the directive moment
+    H u cos(phi), so its rate is sqrt(|k_tilt| H u cos(phi)) / H ~ H^(-1/2): slowed, never
+    stopped (the pair has one negative stiffness: an odd count, which gyroscopic forces
+    cannot stabilise). Between H = 5 and 50 the log-slope is -1/2 to 1e-2 (the neglected
+    terms are of relative order A |k_tilt| / H^2 < 1e-4 and the rotor-bearing coupling)."""
+    P = np.array([params(l2=-0.4, H=H) for H in (0.5, 5.0, 50.0)])
+    c = ladder.classify(ladder.spectrum(MODEL, P, "default"))
+    assert list(c.label) == ["unstable"] * 3 and list(c.unstable_roots) == [2, 2, 2]
+    assert np.ptp(c.growth_rate) / c.growth_rate[0] < 1e-4
+    slope = np.log10(c.slowest_growth[2] / c.slowest_growth[1])
+    assert abs(slope + 0.5) < 1e-2, slope
+    assert c.slowest_growth[0] > 3 * c.slowest_growth[1] > 9 * c.slowest_growth[2]
+
+
 # random parameter sets within the physical ranges of the charts
 SPREAD = st.fixed_dictionaries({
     "H": st.floats(0.1, 10.0), "K0": st.floats(0.1, 10.0), "Kp": st.floats(0.1, 10.0),
@@ -354,3 +371,17 @@ def test_cli_stability_map(tmp_path):
              "--y", "Kgamma", "--y-range", "1", "100", "--points", "6", "--out", str(out), "--quiet")
     assert p.returncode == 0, p.stderr
     assert "stable" in p.stdout and "unstable" in p.stdout and out.exists()
+
+
+def test_cli_stability_map_log_axis(tmp_path):
+    """A log-spaced axis; a log axis through zero is refused in one line, nothing written."""
+    out = tmp_path / "s.png"
+    p = _cli("stability-map", "torsion_gyrocompass", "--x", "l2", "--x-range", "-0.5", "0.3",
+             "--y", "H", "--y-range", "0.01", "10", "--y-log", "--points", "5", "--out", str(out), "--quiet")
+    assert p.returncode == 0, p.stderr
+    assert out.exists()
+    bad = tmp_path / "bad.png"
+    p = _cli("stability-map", "torsion_gyrocompass", "--x", "l2", "--x-range", "-0.5", "0.3",
+             "--y", "H", "--y-range", "0", "10", "--y-log", "--out", str(bad), "--quiet")
+    assert p.returncode == 2 and "--y-log" in p.stderr and len(p.stderr.strip().splitlines()) == 1
+    assert not bad.exists()

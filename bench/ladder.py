@@ -174,7 +174,7 @@ def chart(out: dict) -> None:
         ax.set_xlabel("time per parameter set [s] (one core, batched)")
     for ax in axes[:, 0]:
         ax.set_ylabel("max relative error against the reference")
-    axes[0, 0].legend(fontsize=8, loc="center left")
+    fig.legend(fontsize=8, loc="outside lower center", ncol=7)
     fig.suptitle("Natural frequencies of the torsion gyrocompass: accuracy against speed "
                  "(a point per method and frequency; dashed: 1e-10, dotted: speed goals)", fontsize=10)
     fig.savefig(RESULTS / "ladder_accuracy_speed.png", dpi=120)

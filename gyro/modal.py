@@ -2,10 +2,11 @@
 
 The equilibrium solves the model's equilibrium equations by Newton's method from the
 paper's approximation (2.2), with the operator's stiffness K as the Jacobian. The natural
-frequencies are the eigenvalues of the quadratic problem (M lambda^2 + D lambda + K) x = 0:
-found by a balanced first-order (companion) eigensolver, then each refined by Newton's
-iteration on J(lambda) with its singular vectors, so that the small precession root keeps
-its relative accuracy beside the kilohertz bearing roots.
+frequencies are the eigenvalues of the quadratic problem (M lambda^2 + D lambda + K) x = 0.
+Here are the general solver's parts: a balanced first-order (companion) eigensolver, and
+Newton's iteration on J(lambda) with its singular vectors, so that the small precession
+root keeps its relative accuracy beside the kilohertz bearing roots (the general rung of
+gyro.ladder's default method). `natural_frequencies` answers for one set by the ladder.
 """
 from __future__ import annotations
 
@@ -171,18 +172,16 @@ def refine_all(M, D, K, lams: np.ndarray, chosen: np.ndarray):
     return np.array(roots), np.array(errs)
 
 
-def natural_frequencies(model: Model, values: dict) -> ModalResult:
-    """The natural frequencies of the exact operator about the exact equilibrium."""
-    params = model.vector(values)
-    qe = equilibrium(model, params)
-    M, D, K = (np.asarray(X, dtype=float) for X in model.numpy.operator(params, qe))
-    lams = _companion_eigenvalues(M, D, K)
-    roots, errs = refine_all(M, D, K, lams, representatives(lams, M.shape[0]))
-    freqs = np.abs(roots.imag)
-    idx = np.argsort(freqs)
+def natural_frequencies(model: Model, values: dict, method: str = "default") -> ModalResult:
+    """The natural frequencies of the exact operator about the exact equilibrium, for one
+    parameter set, by a method of the ladder (gyro.ladder; the default one unless told)."""
+    from gyro import ladder
+
+    spec = ladder.spectrum(model, model.vector(values), method)
+    eq = spec.equilibrium[0] if spec.equilibrium is not None else equilibrium(model, model.vector(values))
     return ModalResult(
         model=model.name, params=values,
-        equilibrium=dict(zip(model.meta["equilibrium_coordinates"], map(float, qe))),
-        frequencies=[float(f) for f in freqs[idx]],
-        eigenvalues_re=[float(r) for r in roots.real[idx]],
-        error_estimate=[float(e) for e in errs[idx]])
+        equilibrium=dict(zip(model.meta["equilibrium_coordinates"], map(float, eq))),
+        frequencies=[float(f) for f in spec.frequencies[0]],
+        eigenvalues_re=[float(r) for r in spec.growth[0]],
+        error_estimate=[float(e) for e in spec.error_estimate[0]])

@@ -130,9 +130,17 @@ def stability_grid(model: Model, values: dict, xname, xrange, yname, yrange, poi
             "unstable_roots": st.unstable_roots.reshape(X.shape), "slowest": st.slowest_growth.reshape(X.shape)}
 
 
+def _edges(v: np.ndarray, log: bool) -> np.ndarray:
+    """Cell edges around grid points: midpoints, geometric ones on a log axis."""
+    u = np.log(v) if log else v
+    mid = (u[1:] + u[:-1]) / 2
+    e = np.concatenate([[2 * u[0] - mid[0]], mid, [2 * u[-1] - mid[-1]]])
+    return np.exp(e) if log else e
+
+
 def plot_stability(model: Model, grid: dict, out: Path, lines=()):
-    """The stability map: regions by Poincare's degree of instability (stable, marginal, one
-    growing pair, two or more), solid contours of the fastest growth rate and dashed ones of
+    """The stability map: regions by the number of growing modes (stable, marginal, one, two
+    or more), solid contours of the fastest growth rate and dashed ones of
     the slowest where two or more pairs grow (a growth that gyroscopic coupling slows down
     shows there, not in the fastest). `lines`: (xs, ys, label) curves to overlay, such as an
     analytic stability boundary."""
@@ -145,11 +153,11 @@ def plot_stability(model: Model, grid: dict, out: Path, lines=()):
     degree = np.minimum(grid["unstable_roots"], 2)
     code = np.where(grid["label"] == "marginal", 1, np.where(degree > 0, degree + 1, 0))
     colors = ["#cfe8cf", "#f3e3a1", "#f2b8b0", "#d9786c"]
-    names = ["stable", "marginal", "unstable: one growing pair", "unstable: two or more"]
+    names = ["stable", "marginal", "unstable: one growing mode", "unstable: two or more"]
     fig, ax = plt.subplots(figsize=(7.5, 5.8), layout="constrained")
     units = {p.name: p.unit for p in model.params}
-    ax.pcolormesh(grid["x"], grid["y"], code, cmap=ListedColormap(colors), vmin=-0.5, vmax=3.5,
-                  shading="nearest")
+    ax.pcolormesh(_edges(grid["x"], grid.get("xlog")), _edges(grid["y"], grid.get("ylog")), code,
+                  cmap=ListedColormap(colors), vmin=-0.5, vmax=3.5, shading="flat")
     for key, style, where in (("growth", "-", grid["unstable_roots"] > 0),
                               ("slowest", "--", grid["unstable_roots"] > 1)):
         g = np.where(where & (grid[key] > 0), grid[key], np.nan)

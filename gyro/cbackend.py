@@ -31,6 +31,7 @@ class CompilerUnavailable(RuntimeError):
 
 
 _disabled = 0
+_FAILED: dict[str, CompilerUnavailable] = {}
 
 
 @contextmanager
@@ -76,14 +77,17 @@ def library(model_name: str) -> ctypes.CDLL:
     key = hashlib.sha256(src.read_bytes() + hdr.read_bytes()
                          + " ".join((cc,) + FLAGS + (platform.machine(),)).encode()).hexdigest()[:16]
     out = cache_dir() / f"{model_name}-{key}.so"
+    if key in _FAILED:
+        raise _FAILED[key]
     if not out.exists():
         out.parent.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryDirectory(dir=out.parent) as tmp:
             tmp_so = Path(tmp) / out.name
             proc = subprocess.run([cc, *FLAGS, "-I", str(src.parent), str(src), "-o", str(tmp_so), "-lm"],
                                   capture_output=True, text=True)
-            if proc.returncode != 0:
-                raise CompilerUnavailable(f"{cc} failed on {src.name}: {proc.stderr.strip()[:500]}")
+            if proc.returncode != 0:  # remembered: one failed build per process, not one per call
+                _FAILED[key] = CompilerUnavailable(f"{cc} failed on {src.name}: {proc.stderr.strip()[:500]}")
+                raise _FAILED[key]
             os.replace(tmp_so, out)  # atomic: concurrent builders never see half a file
     return ctypes.CDLL(str(out))
 
@@ -97,8 +101,7 @@ class BatchFunction:
         self.name = fname
         self.in_lens = [len(v) for v in meta["inputs"].values()]
         self.out_shapes = [tuple(v) for v in meta["outputs"].values()]
-        self._fn = getattr(library(model_name), f"{model_name}_{fname}_batch")
-        self._fn.restype = None
+        self._fn = _entry(model_name, f"{model_name}_{fname}_batch")
 
     def __call__(self, *inputs):
         n = max(np.asarray(x).reshape(-1, k).shape[0] for x, k in zip(inputs, self.in_lens))
@@ -110,6 +113,27 @@ class BatchFunction:
         return [o.reshape((n, r) if c == 1 else (n, r, c)) for o, (r, c) in zip(outs, self.out_shapes)]
 
 
+def _entry(model_name: str, symbol: str):
+    """A C entry point of the model's library; CompilerUnavailable when its C has none
+    (a model without an operator, say), so that callers take their NumPy paths."""
+    try:
+        fn = getattr(library(model_name), symbol)
+    except AttributeError:
+        raise CompilerUnavailable(f"{model_name}: the generated C has no {symbol}") from None
+    fn.restype = None
+    return fn
+
+
+def _operator_dim(model_name: str) -> int:
+    return load(model_name).meta["functions"]["operator"]["outputs"]["M"][0]
+
+
+def _check(cond: bool, what: str) -> None:
+    """Shapes are checked before C sees the arrays: a mismatch would read out of bounds."""
+    if not cond:
+        raise ValueError(f"compiled kernel: {what}")
+
+
 def batch_function(model_name: str, fname: str) -> BatchFunction:
     return _built(BatchFunction, model_name, fname)
 
@@ -119,15 +143,17 @@ class QepRefine:
     (templates/qep.c.j2; gyro.ladder._rayleigh_step root by root, in C)."""
 
     def __init__(self, model_name: str):
-        self._fn = getattr(library(model_name), f"{model_name}_qep_refine_batch")
-        self._fn.restype = None
+        self._fn = _entry(model_name, f"{model_name}_qep_refine_batch")
+        self.n = _operator_dim(model_name)
 
     def __call__(self, M, D, K, w, z, iters: int, tol: float):
         """M, D, K (sets, n, n); w (sets, r) and z (sets, r, n) complex: the starts. Returns
         new arrays (w, z, estimate, ok)."""
         M, D, K = (np.ascontiguousarray(X, dtype=float) for X in (M, D, K))
         w = np.array(w, dtype=float, order="C")
-        z = np.array(np.broadcast_to(z, w.shape + (M.shape[-1],)), dtype=complex, order="C")
+        _check(all(X.shape == (w.shape[0], self.n, self.n) for X in (M, D, K)) and w.ndim == 2,
+               f"M, D, K must be (sets, {self.n}, {self.n}) and w (sets, roots)")
+        z = np.array(np.broadcast_to(z, w.shape + (self.n,)), dtype=complex, order="C")
         est, ok = np.empty(w.shape), np.empty(w.shape)
         ptr = ctypes.POINTER(ctypes.c_double)
         self._fn(ctypes.c_long(w.shape[0]), ctypes.c_long(w.shape[1]), ctypes.c_long(iters),
@@ -136,7 +162,7 @@ class QepRefine:
 
 
 def qep_refine(model_name: str) -> QepRefine:
-    """The compiled refinement of a model (AttributeError when its C has none)."""
+    """The compiled refinement of a model (CompilerUnavailable when its C has none)."""
     return _built(QepRefine, model_name)
 
 
@@ -145,15 +171,18 @@ class QepHermitian:
     gyro.ladder._hermitian_block's matrix T, in C)."""
 
     def __init__(self, model_name: str):
-        self._fn = getattr(library(model_name), f"{model_name}_qep_hermitian_batch")
-        self._fn.restype = None
+        self._fn = _entry(model_name, f"{model_name}_qep_hermitian_batch")
+        self.n = _operator_dim(model_name)
 
     def __call__(self, M, D, K, idx):
         """M, D, K (sets, n, n), idx the block's indices. Returns (T, ok): T (sets, 2nb, 2nb)
         complex Hermitian, ok (sets,) where the block's K and M are positive definite."""
         M, D, K = (np.ascontiguousarray(X, dtype=float) for X in (M, D, K))
-        idx = np.ascontiguousarray(idx, dtype=np.int64)
+        idx = np.ascontiguousarray(idx, dtype=np.dtype(ctypes.c_long))
         N, m = M.shape[0], 2 * len(idx)
+        _check(all(X.shape == (N, self.n, self.n) for X in (M, D, K)), f"M, D, K must be (sets, {self.n}, {self.n})")
+        _check(idx.ndim == 1 and 0 < len(idx) <= self.n and len(set(idx.tolist())) == len(idx)
+               and bool(np.all((idx >= 0) & (idx < self.n))), f"block indices must be distinct, in 0..{self.n - 1}")
         T, ok = np.empty((N, m, m), complex), np.empty(N)
         ptr = ctypes.POINTER(ctypes.c_double)
         self._fn(ctypes.c_long(N), ctypes.c_long(len(idx)), idx.ctypes.data_as(ctypes.POINTER(ctypes.c_long)),
@@ -162,7 +191,7 @@ class QepHermitian:
 
 
 def qep_hermitian(model_name: str) -> QepHermitian:
-    """The compiled Hermitian block form of a model (AttributeError when its C has none)."""
+    """The compiled Hermitian block form of a model (CompilerUnavailable when its C has none)."""
     return _built(QepHermitian, model_name)
 
 
@@ -171,13 +200,14 @@ class ModeFormulasSelected:
     gyro.ladder.formulas in one pass over the batch)."""
 
     def __init__(self, model_name: str):
-        self._fn = getattr(library(model_name), f"{model_name}_mode_formulas_selected_batch")
-        self._fn.restype = None
+        self._fn = _entry(model_name, f"{model_name}_mode_formulas_selected_batch")
         self.modes = len(load(model_name).meta["mode_formulas"])
+        self.n_params = len(load(model_name).param_names)
 
     def __call__(self, P):
         """P (sets, parameters). Returns (frequencies, estimates), each (sets, modes)."""
         P = np.ascontiguousarray(P, dtype=float)
+        _check(P.ndim == 2 and P.shape[1] == self.n_params, f"params must be (sets, {self.n_params})")
         f, e = np.empty((P.shape[0], self.modes)), np.empty((P.shape[0], self.modes))
         ptr = ctypes.POINTER(ctypes.c_double)
         self._fn(ctypes.c_long(P.shape[0]), *[a.ctypes.data_as(ptr) for a in (P, f, e)])
@@ -185,5 +215,5 @@ class ModeFormulasSelected:
 
 
 def mode_formulas_selected(model_name: str) -> ModeFormulasSelected:
-    """The compiled selection of a model's mode formulas (AttributeError when it has none)."""
+    """The compiled selection of a model's mode formulas (CompilerUnavailable when it has none)."""
     return _built(ModeFormulasSelected, model_name)

@@ -42,6 +42,7 @@ DEFAULT_TOL = 1e-10
 EPS = np.finfo(float).eps
 REFERENCE_DPS = 40
 FORMULA_CHUNK = 8192
+DEFAULT_CHUNK = 8192
 WIDE = 1e-6  # a root below WIDE x the largest: the spectrum spans more than six decades
 
 
@@ -342,7 +343,7 @@ def _rayleigh(model: Model, M, D, K, w, z, iters, tol, chunk=256):
 
     try:
         return qep_refine(model.name)(M, D, K, w, z, iters, tol)
-    except (CompilerUnavailable, AttributeError):
+    except CompilerUnavailable:
         pass
     N = M.shape[0]
     w, z = w.copy(), np.array(np.broadcast_to(z, w.shape + (M.shape[-1],)), dtype=complex)
@@ -427,39 +428,62 @@ def _input_rounding_structured(model: Model, P, w, z, rel=4 * EPS):
     return out
 
 
+def _pivots_above(A, floor) -> np.ndarray:
+    """Per matrix of a batch of symmetric A: every Cholesky pivot above floor (positive
+    definite with a margin), the pivots being the ratios of the leading principal minors
+    (the test of the generated <model>_qep_hermitian_batch, for the NumPy path)."""
+    ok = np.ones(A.shape[0], bool)
+    prev = np.ones(A.shape[0])
+    with np.errstate(all="ignore"):
+        for k in range(1, A.shape[-1] + 1):
+            det = np.linalg.det(np.where(np.isfinite(A[:, :k, :k]), A[:, :k, :k], 0.0))
+            ok &= (prev > 0) & (det > floor * prev) & np.all(np.isfinite(A[:, :k, :k]), axis=(1, 2))
+            prev = det
+    return ok
+
+
 def _block_starts(model: Model, M, D, K, good):
     """Which sets take the Hermitian path (K > 0 and M > 0 in every diagonal block, with a
     margin) and, for those, the block problems' frequencies (sets taken, n): the starts of
     the refinement. Compiled: the model's generated block form (templates/qep.c.j2), whose
-    Cholesky pivots must exceed 1e3 eps; without a compiler: _hermitian_block, after the
-    least eigenvalue of each scaled K block is found above 1e3 eps."""
+    Cholesky pivots must exceed 1e3 eps; without a compiler: the same test on the leading
+    principal minors (_pivots_above), then _hermitian_block."""
     from gyro.cbackend import CompilerUnavailable, qep_hermitian
 
     blocks = _blocks(model)
     try:
         forms = [qep_hermitian(model.name)(M, D, K, b) for b in blocks]
-    except (CompilerUnavailable, AttributeError):
+    except CompilerUnavailable:
         forms = None
     if forms is not None:
         herm = good & np.all([ok for _, ok in forms], axis=0)
         take = slice(None) if herm.all() else np.flatnonzero(herm)  # no copy when all take it
         mu = [np.linalg.eigvalsh(T[take])[:, len(b):] for (T, _), b in zip(forms, blocks)]
         return herm, 1 / np.concatenate(mu, axis=1)  # mu ascending: w descending per block
-    N = M.shape[0]
-    kmin = np.full(N, -np.inf)
-    dK = np.einsum("bii->bi", K)
-    scalable = good & np.all(dK > 0, axis=1) & np.all(np.einsum("bii->bi", M) > 0, axis=1)
-    if scalable.any():
-        Ks = K[scalable] / np.sqrt(dK[scalable][:, :, None] * dK[scalable][:, None, :])
-        kmin[scalable] = np.min([np.linalg.eigvalsh(Ks[:, b][:, :, b])[:, 0] for b in blocks], axis=0)
-    herm = scalable & (kmin > 1e3 * EPS)
+    dK, dM = np.einsum("bii->bi", K), np.einsum("bii->bi", M)
+    herm = good & np.all(dK > 0, axis=1) & np.all(dM > 0, axis=1)
+    for b in blocks:
+        for X, d in ((K, dK), (M, dM)):
+            with np.errstate(all="ignore"):
+                s = 1 / np.sqrt(d[:, b])
+                herm &= _pivots_above(X[:, b][:, :, b] * s[:, :, None] * s[:, None, :], 1e3 * EPS)
     h = np.flatnonzero(herm)
     Mh, Dh, Kh = M[h], D[h], K[h]
     return herm, np.concatenate([_hermitian_block(Mh[:, b][:, :, b], Dh[:, b][:, :, b], Kh[:, b][:, :, b])
                                  for b in blocks], axis=1)
 
 
+def _in_chunks(method, model: Model, P: np.ndarray, size: int, *args) -> Spectrum:
+    """A method over a large batch, piece by piece (its working arrays sized to the piece)."""
+    parts = [method(model, P[s:s + size], *args) for s in range(0, P.shape[0], size)]
+    cat = {f: (None if getattr(parts[0], f) is None else np.concatenate([getattr(x, f) for x in parts]))
+           for f in ("frequencies", "growth", "error_estimate", "equilibrium", "route")}
+    return Spectrum(parts[0].method, **cat)
+
+
 def default(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
+    if P.shape[0] > DEFAULT_CHUNK:  # bounded memory: the block forms take 3 kB a set
+        return _in_chunks(default, model, P, DEFAULT_CHUNK, tol)
     N = P.shape[0]
     qe, ok = equilibria(model, P)
     M, D, K = operators(model, P, qe)
@@ -467,8 +491,9 @@ def default(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
     freq = np.full((N, n), np.nan)
     growth = np.zeros((N, n))
     est = np.full((N, n), np.inf)
-    route = np.array(["structured"] * N, dtype=object)
     good = ok & _tame(M) & _tame(D) & _tame(K)
+    # which rung answered; "none" where no rung could (no equilibrium in any precision)
+    route = np.where(good, "structured", "none").astype(object)
     herm, w0 = _block_starts(model, M, D, K, good)
     h = np.flatnonzero(herm)
     if h.size:
@@ -602,12 +627,10 @@ def formulas(model: Model, P: np.ndarray) -> Spectrum:
         with np.errstate(all="ignore"):
             f, e = mode_formulas_selected(model.name)(P)
         return Spectrum("formulas", f, np.zeros_like(f), e)
-    except (CompilerUnavailable, AttributeError):
+    except CompilerUnavailable:
         pass
     if P.shape[0] > FORMULA_CHUNK:  # cache-sized pieces: the selection is memory-bound
-        parts = [formulas(model, P[s:s + FORMULA_CHUNK]) for s in range(0, P.shape[0], FORMULA_CHUNK)]
-        f, e = (np.concatenate([getattr(x, a) for x in parts]) for a in ("frequencies", "error_estimate"))
-        return Spectrum("formulas", f, np.zeros_like(f), e)
+        return _in_chunks(formulas, model, P, FORMULA_CHUNK)
     with np.errstate(all="ignore"):
         omega, estimate = getattr(model.numpy, "mode_formulas")(P)
     N = P.shape[0]
@@ -619,7 +642,7 @@ def formulas(model: Model, P: np.ndarray) -> Spectrum:
         f = np.where(better, omega[..., j], f)
         e = np.where(better, estimate[..., j], e)
     e = np.where(np.isfinite(f) & (f > 0), e, np.inf)  # a formula outside its domain (0/0)
-    order = np.argsort(f, axis=1)
+    order = np.argsort(f, axis=1, kind="stable")  # as the C's insertion sort: ties keep their order
     f, e = np.take_along_axis(f, order, 1), np.take_along_axis(e, order, 1)
     return Spectrum("formulas", f, np.zeros_like(f), e)
 
@@ -649,7 +672,7 @@ class Stability:
 
     label: np.ndarray  # (sets,) str
     growth_rate: np.ndarray  # (sets,) largest real part, 1/s (0 when stable)
-    unstable_roots: np.ndarray  # (sets,) int: eigenvalue pairs that grow (Poincare's degree of instability)
+    unstable_roots: np.ndarray  # (sets,) int: growing modes (eigenvalue pairs, or quadruples, with a growing member)
     slowest_growth: np.ndarray  # (sets,) smallest growing real part, 1/s (0 when stable)
 
 

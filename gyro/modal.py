@@ -178,6 +178,8 @@ def natural_frequencies(model: Model, values: dict, method: str = "default") -> 
     from gyro import ladder
 
     spec = ladder.spectrum(model, model.vector(values), method)
+    if not np.all(np.isfinite(spec.frequencies)):
+        raise EquilibriumError(f"{model.name}: no finite spectrum at this set (method {method!r})")
     eq = spec.equilibrium[0] if spec.equilibrium is not None else equilibrium(model, model.vector(values))
     return ModalResult(
         model=model.name, params=values,

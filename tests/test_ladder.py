@@ -205,7 +205,7 @@ def test_stability_across_Kgamma():
 
 
 def test_top_heavy_degree_of_instability_and_gyroscopic_slowing():
-    """Top-heavy (m l2 + M l1 < 0): two pairs grow. The tilt about the spin axis, which the
+    """Top-heavy (m l2 + M l1 < 0): two modes grow. The tilt about the spin axis, which the
     rotor's momentum does not reach, grows at a rate independent of H; the tilt about the
     east axis is coupled by H to the azimuth, whose stiffness is the directive moment
     H u cos(phi), so its rate is sqrt(|k_tilt| H u cos(phi)) / H ~ H^(-1/2): slowed, never
@@ -296,6 +296,48 @@ def test_compiled_formula_selection_agrees_with_numpy(monkeypatch):
     np.testing.assert_array_equal(np.isinf(compiled.error_estimate), np.isinf(numpy_path.error_estimate))
     np.testing.assert_allclose(compiled.frequencies, numpy_path.frequencies, rtol=1e-13, atol=1e-300)
     np.testing.assert_allclose(compiled.error_estimate, numpy_path.error_estimate, rtol=1e-12)
+
+
+def test_compiled_kernels_refuse_wrong_shapes():
+    """The kernels check shapes before C reads the arrays: a block index past n, repeated
+    indices, a parameter row of the wrong length, operators of the wrong size."""
+    from gyro import cbackend
+
+    P = params()[None]
+    qe, _ = ladder.equilibria(MODEL, P)
+    M, D, K = ladder.operators(MODEL, P, qe)
+    herm = cbackend.qep_hermitian(MODEL.name)
+    for idx in ([0, 10], [1, 1], list(range(11)), []):
+        with pytest.raises(ValueError, match="block indices"):
+            herm(M, D, K, idx)
+    with pytest.raises(ValueError, match="params"):
+        cbackend.mode_formulas_selected(MODEL.name)(params())  # one set, not a batch
+    with pytest.raises(ValueError, match="M, D, K"):
+        cbackend.qep_refine(MODEL.name)(M[:, :9, :9], D, K, np.ones((1, 3)), np.ones(10), 1, 0.0)
+
+
+def test_large_batches_run_in_pieces_with_the_same_answers():
+    """Beyond DEFAULT_CHUNK sets the default runs piece by piece (bounded memory): the
+    answers and routes are those of the sets alone."""
+    P = np.array([params(), params(phi=89.99), params(l1=-0.05, l2=-0.05)])
+    big = np.tile(P, (ladder.DEFAULT_CHUNK // 3 + 2, 1))
+    s = ladder.spectrum(MODEL, big, "default")
+    alone = ladder.spectrum(MODEL, P, "default")
+    assert s.frequencies.shape == (len(big), 10) and s.equilibrium.shape[0] == len(big)
+    for k in (0, ladder.DEFAULT_CHUNK - 1, ladder.DEFAULT_CHUNK, len(big) - 1):
+        np.testing.assert_array_equal(s.frequencies[k], alone.frequencies[k % 3])
+        assert s.route[k] == alone.route[k % 3]
+
+
+def test_no_equilibrium_in_any_precision_is_said():
+    """Inputs beyond double precision (Kp = 1e300): no rung answers; the route says 'none',
+    the frequencies are NaN, and the one-set API raises instead of returning them."""
+    from gyro import modal
+
+    s = ladder.spectrum(MODEL, params(Kp=1e300), "default")
+    assert s.route[0] == "none" and np.all(np.isnan(s.frequencies))
+    with pytest.raises(modal.EquilibriumError):
+        modal.natural_frequencies(MODEL, MODEL.parameters({"Kp": 1e300}))
 
 
 def test_refinement_steps_agree_root_by_root():

@@ -74,6 +74,9 @@ def _save(fig, out: Path):
     os.close(fd)
     try:
         fig.savefig(tmp, dpi=130)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # as an ordinary new file (mkstemp makes it private)
         os.replace(tmp, out)
     finally:
         if os.path.exists(tmp):

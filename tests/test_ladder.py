@@ -4,6 +4,7 @@ escalates so that its error stays within its stated estimate (and within 1e-10).
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -391,6 +392,9 @@ def test_cli_campbell_writes_a_png(tmp_path):
     p = _cli("campbell", "torsion_gyrocompass", "--out", str(out), "--points", "12", "--quiet")
     assert p.returncode == 0, p.stderr
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    umask = os.umask(0)
+    os.umask(umask)
+    assert out.stat().st_mode & 0o777 == 0o666 & ~umask  # an ordinary file, not a private temporary
 
 
 @pytest.mark.parametrize("args, word", [

@@ -44,7 +44,7 @@ class CPrinter(C99CodePrinter):
 
     def _print_Pow(self, expr):
         b, e = expr.base, expr.exp
-        if e.is_Integer and 2 <= abs(int(e)) <= 4:
+        if e.is_Integer and 2 <= abs(int(e)) <= 8:
             # parenthesised: the Mul printer puts a power in a denominator as it is (x/(A*A*A))
             prod = "*".join([self.parenthesize(b, 1000)] * abs(int(e)))
             return f"({prod})" if e > 0 else f"(1.0/({prod}))"

@@ -381,3 +381,27 @@ def integral_rates(L, q, qd, qdd, integrals) -> list:
     acc = Mq.LUsolve(f)
     sub = dict(zip(qdd, acc))
     return [time_derivative(I, q, qd, qdd).subs(sub) for I in integrals]
+
+
+def root_series(F, x, x0, eps, order: int) -> list:
+    """Taylor coefficients [x1, ..., x_order] of the root x(eps) = x0 + x1 eps + x2 eps^2 + ...
+    of F(x, eps) = 0 through a simple root x0 of F(x, 0): order by order, each coefficient
+    from a linear equation with the slope dF/dx(x0, 0) as its divisor. The perturbation
+    series behind an approximate frequency formula; its first omitted term estimates the
+    formula's error. Solved on symbols F_ij for the derivatives d^(i+j)F/dx^i deps^j at
+    (x0, 0), which are substituted at the end (no expansion of x0's powers)."""
+    if sp.cancel(F.subs({x: x0, eps: 0})) != 0:
+        raise ValueError("root_series: x0 is not a root of F(x, 0)")
+    d = sp.Symbol("_d")
+    Fs = {(i, j): sp.Symbol(f"_F{i}_{j}") for i in range(order + 1) for j in range(order + 1)
+          if 0 < i + j <= order}
+    T = sum(f * d**i * eps**j / (sp.factorial(i) * sp.factorial(j)) for (i, j), f in Fs.items())
+    cs = sp.symbols(f"_c1:{order + 1}")
+    G = sp.expand(T.subs(d, sum(c * eps**(k + 1) for k, c in enumerate(cs))))
+    out = {}
+    for k in range(1, order + 1):
+        ck = sp.expand(G.coeff(eps, k).subs(out))
+        a = ck.coeff(cs[k - 1])
+        out[cs[k - 1]] = -(ck - a * cs[k - 1]) / a
+    values = {f: sp.diff(F, x, i, eps, j).subs({x: x0, eps: 0}) for (i, j), f in Fs.items()}
+    return [out[c].subs(values) for c in cs]

@@ -23,7 +23,7 @@ import numpy as np
 
 from gyro.models import GENERATED, load
 
-FLAGS = ("-O3", "-march=native", "-std=c99", "-fPIC", "-shared")
+FLAGS = ("-O3", "-march=native", "-std=c99", "-fno-math-errno", "-fPIC", "-shared")
 
 
 class CompilerUnavailable(RuntimeError):

@@ -626,7 +626,7 @@ def formulas(model: Model, P: np.ndarray) -> Spectrum:
     try:
         with np.errstate(all="ignore"):
             f, e = mode_formulas_selected(model.name)(P)
-        return Spectrum("formulas", f, np.zeros_like(f), e)
+        return Spectrum("formulas", f, np.zeros(f.shape), e)
     except CompilerUnavailable:
         pass
     if P.shape[0] > FORMULA_CHUNK:  # cache-sized pieces: the selection is memory-bound
@@ -644,7 +644,7 @@ def formulas(model: Model, P: np.ndarray) -> Spectrum:
     e = np.where(np.isfinite(f) & (f > 0), e, np.inf)  # a formula outside its domain (0/0)
     order = np.argsort(f, axis=1, kind="stable")  # as the C's insertion sort: ties keep their order
     f, e = np.take_along_axis(f, order, 1), np.take_along_axis(e, order, 1)
-    return Spectrum("formulas", f, np.zeros_like(f), e)
+    return Spectrum("formulas", f, np.zeros(f.shape), e)
 
 
 # --------------------------------------------------------------------------- API

@@ -150,6 +150,44 @@ def test_block_polynomials_are_the_determinants(tg_derivation):
     assert [len(c) - 1 for c in v.charpoly] == [4, 6]
 
 
+def test_root_series_against_a_known_expansion():
+    """mechanics.root_series on F = (x - a)(x - 2a) + e (x^2 + b) + e^2 x about x0 = a: the
+    coefficients by hand (x1 = a + b/a, x2 = 25 at a = 1, b = 3), and the remainder of the
+    three-term series falls as e^4 (ratio 1e4 +- 10 % between e = 1e-3 and 1e-4)."""
+    import mpmath
+
+    from derive.mechanics import root_series
+
+    x, e, a, b = sp.symbols("x e a b")
+    F = (x - a) * (x - 2 * a) + e * (x**2 + b) + e**2 * x
+    c = root_series(F, x, a, e, 3)
+    assert sp.simplify(c[0] - (a + b / a)) == 0
+    assert c[1].subs({a: 1, b: 3}) == 25
+    rest = []
+    for ev in (sp.Rational(1, 1000), sp.Rational(1, 10000)):
+        f = sp.lambdify(x, F.subs({a: 1, b: 3, e: ev}), "mpmath")
+        with mpmath.workdps(40):
+            root = mpmath.findroot(f, 1)
+            series = 1 + sum(ck.subs({a: 1, b: 3}) * ev**(k + 1) for k, ck in enumerate(c))
+            rest.append(abs(root - mpmath.mpf(sp.N(series, 40))))
+    assert 0.9e4 < rest[0] / rest[1] < 1.1e4
+    with pytest.raises(ValueError, match="not a root"):
+        root_series(F, x, 3 * a, e, 2)
+
+
+def test_formulas_3_4_and_3_9_are_truncated_root_series():
+    """(3.4) corrected is the first-order series in g of Delta1's root near omega_p^2; (3.9)
+    is the second-order series in g of the pendulum root of det J'' at u = 0 (z = -omega^2).
+    Both identities are exact; the next terms are the formulas' error estimates."""
+    F, _ = tg.section3_formulas()
+    x0, (x1,) = tg.omega2_series(1)
+    assert sp.simplify(x0 + x1 * tg.g - F["omega2"]**2) == 0
+    z1, z2, _ = tg.omega6_series()
+    assert sp.simplify(z1 + 1 / tg.l) == 0
+    w6sq = sp.expand(F["omega6"]**2)
+    assert sp.simplify(z2 + w6sq.coeff(tg.g, 2)) == 0 and sp.simplify(z1 + w6sq.coeff(tg.g, 1)) == 0
+
+
 def test_delta1_is_det_J_prime_with_the_last_term_read_g_m_l(tg_derivation):
     """(3.1): det J'(p) at u = 0, p^2 = -x, is -l^2 m^2 m_c (omega_p^2 - x) Delta1(x), with the
     printed last term 'g m l^2' read 'g m l' (the l^2 reading is not even a constant multiple)."""

@@ -54,6 +54,8 @@ def term_scale(expr):
         if e.is_Integer and e > 0:
             return sp.Pow(term_scale(b), e)
         return sp.Abs(expr) + sp.Abs(e * sp.Pow(b, e - 1)) * term_scale(b)
+    if isinstance(expr, sp.Abs):  # |x| errs as x does
+        return term_scale(expr.args[0])
     if len(expr.args) == 1:
         t = sp.Dummy()
         deriv = sp.diff(expr.func(t), t).subs(t, expr.args[0])

@@ -255,6 +255,55 @@ def L_poly(z, b):
             - wy2**2 * W2)
 
 
+def Delta1(x):
+    """(3.1) Delta1(x), x = omega^2: det J'(p) at u = 0, p^2 = -x, is -l^2 m^2 m_c
+    (omega_p^2 - x) Delta1(x); the last term read g m l (docs/frequencies.md)."""
+    m_s = m * M / (m + M)
+    c2 = I2 + m_s * (l1 - l2)**2
+    d2 = m_s * (l1 - l2) * l + M * l1**2 + M * l1 * l + I2
+    e1 = m_c * l_c * l + I2p
+    return (x**3 * I2 * M / m_c - x**2 * (omega_p2 * c2 + g / l * d2)
+            + x * g / l * (omega_p2 * e1 + g * (M * l1 - m * l - m * l2))
+            - (g / l)**2 * (omega_p2 * m_c * l_c * l - g * m * l))
+
+
+def omega2_series(order: int):
+    """(x0, [x1, ..., x_order]): the root x(g) = x0 + x1 g + x2 g^2 + ... of Delta1 that
+    tends to omega_p^2 c2 m_c/(I2 M) as g -> 0, c2 = I2 + m_*(l1 - l2)^2; (3.4) is its
+    first two terms."""
+    x = sp.Symbol("x")
+    x0 = omega_p2 * (I2 + m * M / (m + M) * (l1 - l2)**2) * m_c / (I2 * M)
+    return x0, mech.root_series(Delta1(x), x, x0, g, order)
+
+
+def omega6_series():
+    """The first three coefficients of the root z(g) = z1 g + z2 g^2 + z3 g^3 + ... of the
+    J'' block's characteristic polynomial at u = 0 (printed (2.4), J''[5,6] = J34/A), the
+    root that vanishes with g: the pendulum mode (3.9). det J''(p) carries the factor p^2
+    of the neutral azimuth at u = 0, divided out first."""
+    p, z = sp.symbols("p z")
+    _, Jpp = printed_operator(p)
+    Jpp = Jpp.subs(u2, 0)
+    Jpp[4, 5] = Jpp[4, 5] / A  # print_corrections: J''[5,6] = J34/A
+    c = mech.charpoly_in_p2(Jpp, p, z)
+    while sp.expand(c[0]) == 0:
+        c = c[1:]
+    return [_grouped(zk) for zk in mech.root_series(sum(ck * z**k for k, ck in enumerate(c)), z, 0, g, 3)]
+
+
+def _grouped(expr):
+    """A rational expression of the parameters rewritten in the paper's groups (Omega,
+    omega_y^2, omega_0^2, m_c, l_c, a) and collected by powers of Omega, omega_y^2 and
+    omega_0^2: the same value with a quarter of the operations (for emission)."""
+    W, wy2, w02, mc, lc, a_ = sp.symbols("W_ wy2_ w02_ mc_ lc_ a_", positive=True)
+    e = sp.factor(sp.cancel(expr.subs({H: W * A, Kgamma: wy2 * A, K0: w02 * m})))
+    e = sp.factor(sp.cancel(e.subs({M: mc - m}).subs({l1: (mc * lc - m * l2) / (mc - m)})))
+    num, den = sp.fraction(e)
+    num = sp.collect(sp.expand(num.subs(I3, (a_ - 1) * A)), [W, wy2, w02], func=sp.factor)
+    back = {W: H / A, wy2: Kgamma / A, w02: K0 / m, mc: m_c, lc: l_c, a_: (A + I3) / A}
+    return (num / den).xreplace(back)
+
+
 def section3_formulas():
     """The paper's approximate frequencies (3.2)-(3.28) and their abbreviations.
 
@@ -330,7 +379,14 @@ def section3_formulas():
         "(3.5) as printed, (g/l omega_p)^2 read g^2/(l^2 omega_p^2); error O(eps2^2)")
     put("omega4", sp.sqrt(g * th2 / l + (g / (l * wp))**2 * Q(th2) / sp.sqrt(disc)),
         "(3.6) as printed; error O(eps2^2)")
+    # (3.4) is the series of Delta1's root near omega_p^2 c2 m_c/(I2 M) in g to first order;
+    # the next term, derived from Delta1 (3.1) itself, estimates what it omits
+    x0, (_, x2) = omega2_series(2)
+    put("omega2_next", sp.Abs(x2) * g**2 / x0,
+        "(3.4): size of the omitted term g^2 x2 of Delta1's root series, relative to omega^2 "
+        "(twice the relative error it causes in omega)")
     sag = {l2: l2 + m * g / Kp}
+    put("omega2_next_eq", F["omega2_next"].xreplace(sag), "(3.4): omega2_next at the exact equilibrium")
     for name in ("omega2", "omega3", "omega4"):
         put(name + "_eq", F[name].xreplace(sag),
             f"{doc[name].split(' ')[0]} at the exact equilibrium: l2 -> l2 + m g/K_p (the "
@@ -341,6 +397,14 @@ def section3_formulas():
                                                  + m / (m_c * w0**2)))),
         "(3.9), left side printed omega_0^2 read omega_6^2; error O(delta6^2), delta6 "
         "the relative size of its correction term (0.068 at the example)")
+    # (3.9) is the series in g of the root of det J''(p) at u = 0 (z = p^2 = -omega^2) that
+    # vanishes with g: z = -g/l + z2 g^2 + z3 g^3 + ...; its first omitted term estimates it
+    z1, _, z3 = omega6_series()
+    put("omega6_next", sp.Abs(z3) * g**2 / sp.Abs(z1),
+        "(3.9): size of the omitted term g^3 z3 of the J'' root series, relative to omega^2 "
+        "(twice the relative error it causes in omega)")
+    put("omega6_eq", F["omega6"].xreplace(sag), "(3.9) at the exact equilibrium: l2 -> l2 + m g/K_p")
+    put("omega6_next_eq", F["omega6_next"].xreplace(sag), "(3.9): omega6_next at the exact equilibrium")
 
     def s8(b):  # (3.14)
         return omega_y2 * W**2 / (a * b * omega_y2 + W**2 * (b - 1))
@@ -393,34 +457,43 @@ def section3_formulas():
 
 
 def mode_formulas(F):
-    """The ten modes by formulas, each with the relative error estimate of what it neglects.
+    """The ten modes by formulas, each with the relative error estimate of what it neglects
+    (docs/methods.md, "Error estimates of the formulas").
 
-    The small parameter and its order come from the derivation and the scaling tests
-    (docs/frequencies.md): eps2^2 for (3.4), eps2 for (3.5)-(3.7) (their u-coupling is not
-    of second order), delta6^2 for (3.9), mu1 + kappa6 for (3.26) (first order in mu1, plus
-    the gravity shift the quartic omits), k^2 + kappa6 for the small-k variant (3.28). For
-    (3.2) corrected it is omega1/omega_y (the next-order coupling with the rotor's angular
-    spring, plus the rounding of u2 near the pole). The constants are calibrated, not
-    derived: 1, except 3 for (3.28) (with 1, a 3000-set sweep of spin, K0, Kp, K_gamma
-    0.1x..10x and latitude 0..89 deg reached ratio 2.8) and 2 for (3.2) (with 1, the
-    spin / 1000 edge errs by 1.4e-5 against 1.1e-5); docs/methods.md, tests/test_ladder.py. The two
-    nutation families are candidates of the same four modes: per set, the one whose
-    estimate is smaller applies (3.26 when k is large, 3.28 when it is small)."""
-    eps2, mu1, k, kappa6, delta6 = F["eps2"], F["mu1"], F["k"], F["kappa6"], F["delta6"]
+    Derived: for (3.4) and (3.9), truncated series in g of a root of Delta1 and of det J''
+    at u = 0, the omitted next term (omega2_next, omega6_next; for (3.9) plus delta6^2, the
+    size of its own correction squared). Small parameters to their order: eps2 for
+    (3.5)-(3.7) (their u-coupling is not of second order), mu1 + kappa6 for (3.26) (first
+    order in mu1, plus the gravity shift the quartic omits), k^2 + kappa6 for the small-k
+    variant (3.28), omega1/omega_y for (3.2) corrected (the next-order coupling with the
+    rotor's angular spring, plus the rounding of u2 near the pole). Those constants are
+    calibrated, not derived: 1, except 3 for (3.28) (with 1, a 3000-set sweep of spin, K0,
+    Kp, K_gamma 0.1x..10x and latitude 0..89 deg reached ratio 2.8) and 2 for (3.2) (with
+    1, the spin / 1000 edge errs by 1.4e-5 against 1.1e-5). The two nutation families are
+    candidates of the same four modes: per set, the one whose estimate is smaller applies
+    (3.26 when k is large, 3.28 when it is small)."""
+    eps2, mu1, k, kappa6 = F["eps2"], F["mu1"], F["k"], F["kappa6"]
     big, small = mu1 + kappa6, 3 * (k**2 + kappa6)
-    return [
+    sag = {l2: l2 + m * g / Kp}
+    modes = [
         # plus the rounding of u2 = u cos(phi) near the pole, where omega1 -> 0
         ("omega1", [("omega1_eq", 2 * F["omega1_eq"] / F["omega_y"] + sp.Float(2.0**-52) * u / F["u2"])]),
-        ("omega2", [("omega2_eq", eps2**2)]),
+        ("omega2", [("omega2_eq", F["omega2_next_eq"])]),
         ("omega3", [("omega3_eq", eps2)]),
         ("omega4", [("omega4_eq", eps2)]),
         ("omega5", [("omega5", eps2)]),
-        ("omega6", [("omega6", delta6**2)]),
+        # the next term of the series, and delta6^2 for a tail that is not small beside it
+        ("omega6", [("omega6_eq", F["omega6_next_eq"] + F["delta6"].xreplace(sag)**2)]),
         ("nutation a", [("omega7", big), ("omega7_smallk", small)]),
         ("nutation b", [("omega8", big), ("omega8_smallk", small)]),
         ("nutation c", [("omega9", big), ("omega9_smallk", small)]),
         ("nutation d", [("omega10", big), ("omega10_smallk", small)]),
     ]
+    # every formula also carries the rounding of its own evaluation (a few hundred operations)
+    return [(mode, [(name, est + ROUNDING) for name, est in cands]) for mode, cands in modes]
+
+
+ROUNDING = sp.Float(2.0**-46)  # 64 eps
 
 
 def build():

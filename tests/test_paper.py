@@ -227,6 +227,29 @@ def test_formulas_3_26_against_the_quartic(ex):
         assert rel(F10[n], q10[i]) < e1[n] / 50, n
 
 
+@pytest.mark.parametrize("spin", [1, 10])
+def test_formulas_3_26_without_condition_3_24(spin):
+    """(3.24) asks delta_b/((b''-1)(b'-1)) << min(1, 1/(a-1)); the text says (3.26) holds
+    without it when mu1 is small. With a light casing (I1 = A, I2 = A + 2e-4) the ratio is
+    2.4 instead of 0.005: the errors of omega8 and omega7 against the quartic grow more
+    than fivefold over the same spin under (3.24), and every error stays below mu1, the
+    order the text claims (and the ladder's estimate mu1 + kappa6 uses)."""
+    A = 1.2e-4
+    H = 0.452316 * spin
+    light = {"I1": A, "I2": A + 2e-4, "H": H}
+    names = ("omega8", "omega9", "omega7", "omega10")  # ascending at both sets
+    errs = {}
+    for key, over in (("(3.24) holds", {"H": H}), ("(3.24) fails", light)):
+        F, _ = formulas(**over)
+        cond = F["delta_b"] / ((F["b2"] - 1) * (F["b1"] - 1)) / min(1, 1 / (F["a"] - 1))
+        q = quartic_roots(**over)
+        errs[key] = np.array([rel(F[n], qi) for n, qi in zip(names, q)])
+        assert np.all(errs[key] < F["mu1"]), (key, errs[key], F["mu1"])
+        assert (cond < 0.01) if key == "(3.24) holds" else (cond > 1)
+    growth = errs["(3.24) fails"] / errs["(3.24) holds"]
+    assert growth[0] > 5 and growth[2] > 5, growth
+
+
 def test_printed_formula_values_3_26(ex):
     """By formulas (3.26) the paper prints 51.977; 356.42; 644.41; 3851.61. 644.41 agrees;
     3851.61 agrees with Omega = 3769.5 (above); 51.977 and 356.42 are not reproduced: the

@@ -18,6 +18,9 @@ from derive import mechanics as mech
 from derive.model import Function, Model
 
 P_SYMBOL = sp.Symbol("p")  # the operator d/dt
+# every formula's estimate also carries the rounding of evaluating it in double precision
+# (a few hundred operations): 64 eps
+FORMULA_ROUNDING = sp.Float(2.0**-46)
 MATRICES = ("M", "D", "K", "J", "J_re", "J_im", "Mq")  # outputs that stay matrices when 1x1
 Z_SYMBOL = sp.Symbol("z")  # p^2
 
@@ -224,10 +227,10 @@ def functions(d: Derivation) -> list[Function]:
         rows = [c + [c[-1]] * (width - len(c)) for _, c in model.mode_formulas]  # pad: repeat
         fns.append(Function("mode_formulas", [params],
                             [("omega", sp.Matrix([[model.formulas[n] for n, _ in r] for r in rows])),
-                             ("estimate", sp.Matrix([[e for _, e in r] for r in rows]))],
+                             ("estimate", sp.Matrix([[e + FORMULA_ROUNDING for _, e in r] for r in rows]))],
                             "Approximate natural frequencies, a row per mode (metadata "
                             "'mode_formulas'), a column per candidate formula, with each "
-                            "candidate's relative error estimate.", MATRICES))
+                            "candidate's relative error estimate (plus 64 eps of rounding).", MATRICES))
     fns.append(Function("mass_matrix", [params, ("q", model.q)], [("Mq", d.mass_matrix)],
                         "Mass matrix of the full nonlinear equations: Mq qdd = f.", MATRICES))
     given = [("given", model.given_values), ("dgiven", model.given_derivatives),

@@ -187,11 +187,13 @@ def test_nutation_estimate_is_exceeded_far_from_the_example():
 def test_estimate_of_3_9_holds_where_delta6_squared_does_not():
     """(3.9) is the series of the pendulum root of det J''(p) in g to second order (its
     second term is the derived z2, asserted in tests/test_derivation.py). With a long
-    torsion bar (l = 0.5 m) delta6^2 underestimates its error by 1.6x; the omitted term
-    g^3 z3 (relative to omega^2) plus delta6^2 bounds it and stays within 3x of it."""
+    torsion bar (l = 0.5 m) delta6^2 underestimates its error by 1.6x. The omitted term
+    g^3 z3 relative to omega^2 is twice the relative error it causes, as for (3.4): the
+    error is 0.4..0.6 of it, and within the estimate (that term plus delta6^2)."""
     err, est, F = _formula_error({"l": 0.5}, "omega6_eq")
     assert err > F["delta6"] ** 2
-    assert est / 3 < err <= est, (err, est)
+    assert 0.4 < err / F["omega6_next_eq"] < 0.6, (err, F["omega6_next_eq"])
+    assert err <= est
 
 
 def test_formulas_pick_the_small_k_family_at_small_spin():
@@ -245,6 +247,8 @@ def test_top_heavy_degree_of_instability_and_gyroscopic_slowing():
     P = np.array([params(l2=-0.4, H=H) for H in (0.5, 5.0, 50.0)])
     c = ladder.classify(ladder.spectrum(MODEL, P, "default"))
     assert list(c.label) == ["unstable"] * 3 and list(c.unstable_roots) == [2, 2, 2]
+    # H reaches the spin-axis tilt only through the weak coupling of the blocks, about 1e-4
+    # of the entries at the example (docs/methods.md): its rate moves by less than that
     assert np.ptp(c.growth_rate) / c.growth_rate[0] < 1e-4
     slope = np.log10(c.slowest_growth[2] / c.slowest_growth[1])
     assert abs(slope + 0.5) < 1e-2, slope

@@ -110,7 +110,7 @@ def test_omega2_to_4_against_the_roots_of_delta1(ex):
     """(3.4) corrected, (3.5), (3.6) are the first two terms of the series in eps2: their
     error against Delta1's roots is O(eps2^2) = 1.2e-8 (bound 10 eps2^2). The printed (3.4)
     has a wrong first-order term: its error is of order eps2 itself."""
-    F, v = ex["F"], ex["v"]
+    F = ex["F"]
     eps2 = F["eps2"]
     r = delta1_roots()
     assert rel(F["omega3"], r[0]) < 10 * eps2**2

@@ -255,13 +255,23 @@ def L_poly(z, b):
             - wy2**2 * W2)
 
 
+# the rotor's radial sag in its bearing: the exact equilibrium at u = 0 is the print's
+# linearisation point with l2 -> l2 + m g/K_p (docs/frequencies.md); the `_eq` formulas
+SAG = {l2: l2 + m * g / Kp}
+
+
+def delta1_groups():
+    """(c2, d2, e1) of Delta1 (3.1) and (3.4)-(3.6): c2 = I2 + m_*(l1 - l2)^2,
+    d2 = m_*(l1 - l2) l + M l1^2 + M l1 l + I2, e1 = m_c l_c l + I2'."""
+    m_s = m * M / (m + M)
+    return (I2 + m_s * (l1 - l2)**2, m_s * (l1 - l2) * l + M * l1**2 + M * l1 * l + I2,
+            m_c * l_c * l + I2p)
+
+
 def Delta1(x):
     """(3.1) Delta1(x), x = omega^2: det J'(p) at u = 0, p^2 = -x, is -l^2 m^2 m_c
     (omega_p^2 - x) Delta1(x); the last term read g m l (docs/frequencies.md)."""
-    m_s = m * M / (m + M)
-    c2 = I2 + m_s * (l1 - l2)**2
-    d2 = m_s * (l1 - l2) * l + M * l1**2 + M * l1 * l + I2
-    e1 = m_c * l_c * l + I2p
+    c2, d2, e1 = delta1_groups()
     return (x**3 * I2 * M / m_c - x**2 * (omega_p2 * c2 + g / l * d2)
             + x * g / l * (omega_p2 * e1 + g * (M * l1 - m * l - m * l2))
             - (g / l)**2 * (omega_p2 * m_c * l_c * l - g * m * l))
@@ -272,7 +282,7 @@ def omega2_series(order: int):
     tends to omega_p^2 c2 m_c/(I2 M) as g -> 0, c2 = I2 + m_*(l1 - l2)^2; (3.4) is its
     first two terms."""
     x = sp.Symbol("x")
-    x0 = omega_p2 * (I2 + m * M / (m + M) * (l1 - l2)**2) * m_c / (I2 * M)
+    x0 = omega_p2 * delta1_groups()[0] * m_c / (I2 * M)
     return x0, mech.root_series(Delta1(x), x, x0, g, order)
 
 
@@ -358,9 +368,7 @@ def section3_formulas():
         "m^2 g^2/K_p to G")
 
     # omega2..omega4, (3.3)-(3.6)
-    c2 = I2 + m_s * (l1 - l2)**2
-    d2 = m_s * (l1 - l2) * l + M * l1**2 + M * l1 * l + I2
-    e1 = m_c * l_c * l + I2p
+    c2, d2, e1 = delta1_groups()
     lead = Kp / m_s * (1 + m_s * (l1 - l2)**2 / I2)
     put("omega2_printed", sp.sqrt(lead + g / l * (d2 * m_c / (I2 * M) - m_c * l_c * l / c2)),
         "(3.4) as printed: second term -m_c l_c l/[I2 + m_*(l1-l2)^2]; error O(eps2)")
@@ -385,10 +393,9 @@ def section3_formulas():
     put("omega2_next", sp.Abs(x2) * g**2 / x0,
         "(3.4): size of the omitted term g^2 x2 of Delta1's root series, relative to omega^2 "
         "(twice the relative error it causes in omega)")
-    sag = {l2: l2 + m * g / Kp}
-    put("omega2_next_eq", F["omega2_next"].xreplace(sag), "(3.4): omega2_next at the exact equilibrium")
+    put("omega2_next_eq", F["omega2_next"].xreplace(SAG), "(3.4): omega2_next at the exact equilibrium")
     for name in ("omega2", "omega3", "omega4"):
-        put(name + "_eq", F[name].xreplace(sag),
+        put(name + "_eq", F[name].xreplace(SAG),
             f"{doc[name].split(' ')[0]} at the exact equilibrium: l2 -> l2 + m g/K_p (the "
             "rotor's radial sag, an O(eps2) effect the linearisation at q = 0 drops)")
 
@@ -403,8 +410,8 @@ def section3_formulas():
     put("omega6_next", sp.Abs(z3) * g**2 / sp.Abs(z1),
         "(3.9): size of the omitted term g^3 z3 of the J'' root series, relative to omega^2 "
         "(twice the relative error it causes in omega)")
-    put("omega6_eq", F["omega6"].xreplace(sag), "(3.9) at the exact equilibrium: l2 -> l2 + m g/K_p")
-    put("omega6_next_eq", F["omega6_next"].xreplace(sag), "(3.9): omega6_next at the exact equilibrium")
+    put("omega6_eq", F["omega6"].xreplace(SAG), "(3.9) at the exact equilibrium: l2 -> l2 + m g/K_p")
+    put("omega6_next_eq", F["omega6_next"].xreplace(SAG), "(3.9): omega6_next at the exact equilibrium")
 
     def s8(b):  # (3.14)
         return omega_y2 * W**2 / (a * b * omega_y2 + W**2 * (b - 1))
@@ -474,8 +481,7 @@ def mode_formulas(F):
     (3.26 when k is large, 3.28 when it is small)."""
     eps2, mu1, k, kappa6 = F["eps2"], F["mu1"], F["k"], F["kappa6"]
     big, small = mu1 + kappa6, 3 * (k**2 + kappa6)
-    sag = {l2: l2 + m * g / Kp}
-    modes = [
+    return [
         # plus the rounding of u2 = u cos(phi) near the pole, where omega1 -> 0
         ("omega1", [("omega1_eq", 2 * F["omega1_eq"] / F["omega_y"] + sp.Float(2.0**-52) * u / F["u2"])]),
         ("omega2", [("omega2_eq", F["omega2_next_eq"])]),
@@ -483,17 +489,12 @@ def mode_formulas(F):
         ("omega4", [("omega4_eq", eps2)]),
         ("omega5", [("omega5", eps2)]),
         # the next term of the series, and delta6^2 for a tail that is not small beside it
-        ("omega6", [("omega6_eq", F["omega6_next_eq"] + F["delta6"].xreplace(sag)**2)]),
+        ("omega6", [("omega6_eq", F["omega6_next_eq"] + F["delta6"].xreplace(SAG)**2)]),
         ("nutation a", [("omega7", big), ("omega7_smallk", small)]),
         ("nutation b", [("omega8", big), ("omega8_smallk", small)]),
         ("nutation c", [("omega9", big), ("omega9_smallk", small)]),
         ("nutation d", [("omega10", big), ("omega10_smallk", small)]),
     ]
-    # every formula also carries the rounding of its own evaluation (a few hundred operations)
-    return [(mode, [(name, est + ROUNDING) for name, est in cands]) for mode, cands in modes]
-
-
-ROUNDING = sp.Float(2.0**-46)  # 64 eps
 
 
 def build():

@@ -1,40 +1,100 @@
-"""`python -m derive [--out DIR] [MODEL ...]`: derive and emit models, step by step."""
+"""`python -m derive [--out DIR] [MODEL ...]` derives and emits the models of derive/models/;
+`python -m derive --model PATH.py --out DIR` a model file that lives anywhere. Each model goes
+to DIR/<name>/, step by step with the time of each step."""
 from __future__ import annotations
 
 import argparse
 import importlib
+import importlib.util
 import sys
 import time
 from pathlib import Path
 
 from derive import emit, pipeline
+from derive.model import Model, Unsupported
 from derive.models import MODELS
+
+
+class NotAModel(ValueError):
+    """A file or module that does not define a model; the message is one line."""
+
+
+def load_file(path: str | Path):
+    """The module of a model file (or of a model folder's __init__.py) anywhere on disk,
+    registered under a private name so that its own imports and the emitter find it."""
+    path = Path(path).resolve()
+    if path.is_dir():
+        path = path / "__init__.py"
+    if not path.is_file():
+        raise NotAModel(f"{path}: no such model file")
+    if path.suffix != ".py":
+        raise NotAModel(f"{path}: a model file is a Python file (.py)")
+    stem = path.parent.name if path.name == "__init__.py" else path.stem
+    modname = f"_derive_model_{stem}"
+    spec = importlib.util.spec_from_file_location(
+        modname, path, submodule_search_locations=[str(path.parent)] if path.name == "__init__.py" else None)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[modname] = module
+    try:
+        spec.loader.exec_module(module)
+    except Exception as exc:  # a model file's own error, reported in one line
+        del sys.modules[modname]
+        raise NotAModel(f"{path}: importing it failed: {type(exc).__name__}: {exc}") from exc
+    return module
+
+
+def build(module) -> Model:
+    """The Model that a module's build() returns, checked to be one."""
+    where = getattr(module, "__file__", module.__name__)
+    if not callable(getattr(module, "build", None)):
+        raise NotAModel(f"{where}: not a model: it defines no build() function")
+    model = module.build()
+    if not isinstance(model, Model):
+        raise NotAModel(f"{where}: not a model: build() returned {type(model).__name__}, not derive.model.Model")
+    if sys.modules.get(model.module) is not module:
+        model.module = module.__name__  # the emitter hashes the file this module came from
+    return model
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m derive", description=__doc__)
     ap.add_argument("models", nargs="*", help=f"models to derive (default: all of {', '.join(MODELS)})")
+    ap.add_argument("--model", metavar="PATH.py", action="append", default=[],
+                    help="a model file (or folder) anywhere; may be repeated")
     ap.add_argument("--out", default="generated", help="output folder (default: generated)")
     args = ap.parse_args(argv)
-    names = args.models or list(MODELS)
-    for name in names:
+    for name in args.models:
         if name not in MODELS:
             print(f"derive: unknown model {name!r}; known: {', '.join(MODELS)}", file=sys.stderr)
             return 2
+    try:
+        modules = [load_file(p) for p in args.model]
+        jobs = [(m, build(m)) for m in modules]
+    except NotAModel as exc:
+        print(f"derive: {exc}", file=sys.stderr)
+        return 2
+    if not args.model or args.models:
+        for name in args.models or list(MODELS):
+            module = importlib.import_module(MODELS[name])
+            jobs.append((module, None))
     t_all = time.perf_counter()
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "__init__.py").write_text(emit.environment().get_template("generated_init.py.j2").render())
-    for name in names:
+    for module, model in jobs:
+        name = model.name if model else module.__name__.rsplit(".", 1)[-1]
         steps = pipeline.Steps(prefix=f"[{name}] ")
-        with steps("model: energies and parameters"):
-            model = importlib.import_module(MODELS[name]).build()
-        deriv = pipeline.derive(model, steps)
-        with steps("functions to emit"):
-            fns = pipeline.functions(deriv)
-        with steps("emit: CSE, CasADi, NumPy, C through the templates"):
-            files = emit.emit(model, fns, pipeline.metadata(deriv), Path(args.out) / name)
-        print(f"[{name}] {len(files)} files in {Path(args.out) / name}; {steps.total:.1f} s", file=sys.stderr)
+        try:
+            with steps("model: energies and parameters"):
+                model = model or build(module)
+            deriv = pipeline.derive(model, steps)
+            with steps("functions to emit"):
+                fns = pipeline.functions(deriv)
+            with steps("emit: CSE, CasADi, NumPy, mpmath, C through the templates"):
+                files = emit.emit(model, fns, pipeline.metadata(deriv), out / model.name)
+        except (Unsupported, NotAModel) as exc:
+            print(f"derive: {name}: {exc}", file=sys.stderr)
+            return 2
+        print(f"[{name}] {len(files)} files in {out / model.name}; {steps.total:.1f} s", file=sys.stderr)
+    (out / "__init__.py").write_text(emit.environment().get_template("generated_init.py.j2").render())
     print(f"derive: done in {time.perf_counter() - t_all:.1f} s", file=sys.stderr)
     return 0
 

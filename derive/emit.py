@@ -7,9 +7,10 @@ common-subexpression elimination; the same CSE is printed four ways:
 - `mpmath_functions.py`: the same in arbitrary precision (references for tests and charts);
 - `<model>.h`, `<model>.c`: flat, allocation-free C99, each function also over a batch.
 Every file starts with a header naming the template it came from, saying it must not be
-edited, and carrying a hash of the inputs that made it (the sources of `derive/`, the
-templates and the pinned SymPy, SymEngine and CasADi versions). Bytes are deterministic:
-no timestamps, canonical CSE order, sorted JSON.
+edited, and carrying a hash of the inputs that made it (the shared machinery of `derive/`,
+the templates, the model's own file or folder and the pinned SymPy, SymEngine and CasADi
+versions; not the other models). Bytes are deterministic: no timestamps, canonical CSE
+order, sorted JSON; each function's inputs and outputs are listed in call order.
 """
 from __future__ import annotations
 
@@ -186,17 +187,65 @@ def tool_versions() -> dict[str, str]:
     return {name: importlib_metadata.version(name) for name in TOOL_VERSIONS}
 
 
+def model_files(model_file: Path) -> list[Path]:
+    """The files a model is made of: its module file, or every .py of its package folder."""
+    model_file = Path(model_file).resolve()
+    if model_file.name == "__init__.py":
+        return sorted(model_file.parent.rglob("*.py"))
+    return [model_file]
+
+
+def _shown(path: Path) -> str:
+    """A path as the generated files show it: relative to the repository when inside it,
+    else the file's name alone (bytes must not depend on where a checkout lives)."""
+    path = Path(path).resolve()
+    try:
+        return path.relative_to(ROOT).as_posix()
+    except ValueError:
+        return path.name
+
+
+def machinery_files() -> list[Path]:
+    """The shared machinery: every source of derive/ outside derive/models/, and the templates."""
+    models = ROOT / "derive" / "models"
+    return sorted([f for f in (ROOT / "derive").rglob("*.py") if models not in f.parents]
+                  + list(TEMPLATES.glob("*.j2")))
+
+
 def input_hash(model_module_file: Path) -> str:
-    """SHA-256 of what makes the generated files: derive/ sources (the model's among them),
-    the templates and the versions of the symbolic tools."""
+    """SHA-256 of what makes one model's generated files: the shared machinery and the
+    templates, the model's own file(s) and the versions of the symbolic tools. Other
+    models are not part of it: adding or changing a model rewrites only its own files."""
     h = hashlib.sha256()
-    files = sorted(set((ROOT / "derive").rglob("*.py")) | set(TEMPLATES.glob("*.j2")) | {Path(model_module_file)})
-    for f in files:
-        h.update(str(f.relative_to(ROOT)).encode())
+    mine = model_files(model_module_file)
+    base = Path(model_module_file).resolve().parent
+    for f in machinery_files():
+        h.update(_shown(f).encode())
+        h.update(b"\0")
+        h.update(f.read_bytes())
+    for f in mine:
+        h.update(f.resolve().relative_to(base).as_posix().encode())
         h.update(b"\0")
         h.update(f.read_bytes())
     h.update(json.dumps(tool_versions(), sort_keys=True).encode())
     return h.hexdigest()
+
+
+def check_names(functions: list[Function]) -> None:
+    """Every input symbol of every function can be emitted, and none is an input twice."""
+    from derive.model import Unsupported
+    from derive.names import problem
+
+    for fn in functions:
+        seen = set()
+        for group, syms in fn.inputs:
+            for s in syms:
+                why = None if group == "pval" else problem(str(s))  # pval: the machinery's p
+                if why:
+                    raise Unsupported(f"{fn.name}: input {s} (in {group}) cannot be emitted: {why}")
+                if str(s) in seen:
+                    raise Unsupported(f"{fn.name}: input {s} appears twice")
+                seen.add(str(s))
 
 
 def _operator_dim(functions: list[Function]) -> int:
@@ -227,9 +276,13 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
     """Write the generated package of one model into outdir (created, files overwritten)."""
     import importlib
 
+    import sys
+
+    check_names(functions)
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
-    module_file = Path(importlib.import_module(model.module).__file__)
+    module = sys.modules.get(model.module) or importlib.import_module(model.module)
+    module_file = Path(module.__file__)
     digest = input_hash(module_file)
     env = environment()
     printers = {"c": CPrinter(), "numpy": NumpyPrinter(), "casadi": CasadiPrinter(),
@@ -239,7 +292,7 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
         temps, reduced, ops, ops_before = _cse(fn)
         for key, printer in printers.items():
             emitted[key].append(_printed(fn, temps, reduced, ops, ops_before, printer))
-    source = str(module_file.relative_to(ROOT))
+    source = _shown(module_file)
     common = dict(model=model.name, title=model.title, paper=model.source, source=source,
                   digest=digest, versions=tool_versions(), prefix=model.name, qep_n=_operator_dim(functions),
                   select=_mode_select(functions))
@@ -260,9 +313,11 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
     meta = dict(metadata)
     meta["generated"] = {"by": "derive", "source": source, "input_hash": digest,
                          "versions": tool_versions()}
+    # inputs and outputs as lists, in call order: every backend reads the order from here
     meta["functions"] = {
-        f.name: {"doc": f.doc, "inputs": {i.name: i.symbols for i in f.inputs},
-                 "outputs": {o.name: [o.rows, o.cols] for o in f.outputs},
+        f.name: {"doc": f.doc,
+                 "inputs": [{"name": i.name, "symbols": i.symbols} for i in f.inputs],
+                 "outputs": [{"name": o.name, "shape": [o.rows, o.cols]} for o in f.outputs],
                  "ops": f.ops, "ops_before_cse": f.ops_before}
         for f in emitted["numpy"]}
     path = outdir / "metadata.json"

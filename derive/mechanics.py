@@ -91,8 +91,39 @@ def _se_list(xs):
     return [se.sympify(x) for x in xs]
 
 
-def _time_derivative_se(e, q, qd, qdd=None):
+TIME = sp.Symbol("t")  # explicit time (derive.model.TIME)
+_TIME_SE = se.Symbol("t")
+
+
+def chain(signals: Sequence = ()) -> tuple:
+    """The explicit part of d/dt as pairs (symbol, its derivative): t -> 1, and along each
+    signal's ladder s -> s_d -> s_dd; the last rung's derivative is None (not declared).
+    `signals` are `Signal`s or ladders of symbols [s, s_d, ...]."""
+    pairs = [(_TIME_SE, se.Integer(1))]
+    for sig in signals:
+        ladder = _se_list(getattr(sig, "symbols", sig))
+        pairs += list(zip(ladder, ladder[1:] + [None]))
+    return tuple(pairs)
+
+
+def _partial_time_se(e, explicit):
+    """The explicit part of the time derivative of e: d/dt at fixed q and qd."""
     out = se.Integer(0)
+    for s, ds in explicit:
+        d = e.diff(s)
+        if d == 0:
+            continue
+        if ds is None:
+            from derive.model import Unsupported
+
+            raise Unsupported(f"the derivative of the signal rung {s} is needed: declare the "
+                              "signal with a higher order")
+        out += d * ds
+    return out
+
+
+def _time_derivative_se(e, q, qd, qdd=None, explicit=None):
+    out = _partial_time_se(e, explicit if explicit is not None else chain())
     for qi, vi in zip(q, qd):
         out += e.diff(qi) * vi
     if qdd is not None:
@@ -101,13 +132,19 @@ def _time_derivative_se(e, q, qd, qdd=None):
     return out
 
 
-def time_derivative(expr, q: Sequence, qd: Sequence, qdd: Sequence | None = None):
-    """Total time derivative of expr(q, qd) by the chain rule (no explicit time)."""
+def time_derivative(expr, q: Sequence, qd: Sequence, qdd: Sequence | None = None, signals: Sequence = ()):
+    """Total time derivative of expr(q, qd, t, signals) by the chain rule: the partial
+    derivative in the time symbol t, each signal's rung times the next one, then q and qd."""
     if isinstance(expr, sp.MatrixBase):
-        return expr.applyfunc(lambda e: time_derivative(e, q, qd, qdd))
+        return expr.applyfunc(lambda e: time_derivative(e, q, qd, qdd, signals))
     qs, vs = _se_list(q), _se_list(qd)
     acc = None if qdd is None else _se_list(qdd)
-    return _sp(_time_derivative_se(_se(expr), qs, vs, acc))
+    return _sp(_time_derivative_se(_se(expr), qs, vs, acc, chain(signals)))
+
+
+def partial_time(expr, signals: Sequence = ()):
+    """d/dt of expr at fixed q and qd: through t and the signals only."""
+    return _sp(_partial_time_se(_se(expr), chain(signals)))
 
 
 def kinetic_energy(mass=0, velocity=None, inertia_diag=None, omega=None):
@@ -125,27 +162,65 @@ def kinetic_energy(mass=0, velocity=None, inertia_diag=None, omega=None):
 # --------------------------------------------------------------------------- Lagrange
 
 
-def _lagrange_se(L, q, qd, qdd):
-    return [_time_derivative_se(L.diff(vi), q, qd, qdd) - L.diff(qi) for qi, vi in zip(q, qd)]
+def _lagrange_se(L, q, qd, qdd, explicit=None):
+    return [_time_derivative_se(L.diff(vi), q, qd, qdd, explicit) - L.diff(qi) for qi, vi in zip(q, qd)]
 
 
-def lagrange_equations(L, q, qd, qdd) -> list:
-    """E_i = d/dt dL/dqd_i - dL/dq_i (1.13-type equations; E = Q for given forces Q)."""
-    return [_sp(e) for e in _lagrange_se(_se(L), _se_list(q), _se_list(qd), _se_list(qdd))]
+def lagrange_equations(L, q, qd, qdd, Q=None, signals: Sequence = ()) -> list:
+    """E_i = d/dt dL/dqd_i - dL/dq_i - Q_i (1.13-type equations; E = 0 on a motion), with
+    the generalised forces Q (zero if None) and explicit time and signals in d/dt."""
+    Es = _lagrange_se(_se(L), _se_list(q), _se_list(qd), _se_list(qdd), chain(signals))
+    if Q is not None:
+        Es = [e - _se(Qi) for e, Qi in zip(Es, Q)]
+    return [_sp(e) for e in Es]
 
 
-def mass_matrix_form(L, q, qd):
-    """Mass-matrix form of the Lagrange equations: E = Mq(q) qdd - f(q, qd).
+def mass_matrix_form(L, q, qd, Q=None, signals: Sequence = ()):
+    """Mass-matrix form of the equations d/dt dL/dqd - dL/dq = Q: Mq(q) qdd = f(q, qd).
 
-    Mq = d2L/dqd dqd, f = dL/dq - (d2L/dqd dq) qd. The mass matrix is never inverted
-    symbolically: simulation solves Mq qdd = f numerically.
+    Mq = d2L/dqd dqd, f = dL/dq - (d2L/dqd dq) qd - d/dt|explicit dL/dqd + Q, the explicit
+    part through t and the signals. The mass matrix is never inverted symbolically:
+    simulation solves Mq qdd = f numerically.
     """
     Ls, qs, vs = _se(L), _se_list(q), _se_list(qd)
+    explicit = chain(signals)
     p = [Ls.diff(v) for v in vs]
     Mq = [[pi.diff(w) for w in vs] for pi in p]
     f = [Ls.diff(qi) - sum((pi.diff(qj) * vj for qj, vj in zip(qs, vs)), se.Integer(0))
-         for qi, pi in zip(qs, p)]
+         - _partial_time_se(pi, explicit) for qi, pi in zip(qs, p)]
+    if Q is not None:
+        f = [fi + _se(Qi) for fi, Qi in zip(f, Q)]
     return sp.Matrix(Mq).applyfunc(_sp), sp.Matrix(f).applyfunc(_sp)
+
+
+# --------------------------------------------------------------------------- forces
+
+
+def rayleigh_forces(F, qd) -> list:
+    """Generalised forces of a Rayleigh dissipation function: Q_k = -dF/dqd_k."""
+    Fs = _se(F)
+    return [_sp(-Fs.diff(v)) for v in _se_list(qd)]
+
+
+def load_forces(vector, velocity, qd) -> list:
+    """Generalised forces of a force on a point (a moment on a body) by virtual power:
+    Q_k = vector . d velocity / d qd_k, velocity that of the point (the angular velocity of
+    the body) in the components of vector. The velocity of a holonomic system is affine in
+    qd; anything else is refused."""
+    from derive.model import Unsupported
+
+    vec, vel = [_se(x) for x in sp.Matrix(vector)], [_se(x) for x in sp.Matrix(velocity)]
+    if len(vec) != len(vel):
+        raise Unsupported(f"a load's vector has {len(vec)} components and its velocity {len(vel)}")
+    vs = _se_list(qd)
+    out = []
+    for v in vs:
+        partial = [c.diff(v) for c in vel]
+        if any(pc.diff(w) != 0 for pc in partial for w in vs):
+            raise Unsupported("a load's velocity is not affine in the generalised velocities: "
+                              "not the velocity of a point of a holonomic system")
+        out.append(_sp(se.expand(sum((a * b for a, b in zip(vec, partial)), se.Integer(0)))))
+    return out
 
 
 def is_cyclic(L, coordinate) -> bool:
@@ -180,7 +255,7 @@ def routhian(L, velocity, momentum):
     return _sp(se.expand(c - b**2 / (2 * a)) + beta * b / a - beta**2 / (2 * a))
 
 
-def eliminate_cyclic(equations, q, qd, qdd, index, L, momentum):
+def eliminate_cyclic(equations, q, qd, qdd, index, L, momentum, signals: Sequence = ()):
     """Substitute the cyclic integrals dL/dv_c = beta_c into the full equations.
 
     `index` and `momentum` are one coordinate index and its momentum, or lists of them.
@@ -199,7 +274,7 @@ def eliminate_cyclic(equations, q, qd, qdd, index, L, momentum):
     Kv = sp.Matrix([[_sp(pc.diff(v)) for v in cv] for pc in pcs])
     b = sp.Matrix([_sp(pc.subs({v: 0 for v in cv})) for pc in pcs])
     v_sol = Kv.LUsolve(sp.Matrix(betas) - b)
-    dpcs = [_time_derivative_se(pc, qs, vs, acc) for pc in pcs]
+    dpcs = [_time_derivative_se(pc, qs, vs, acc, chain(signals)) for pc in pcs]
     Ka = sp.Matrix([[_sp(d.diff(a)) for a in ca] for d in dpcs])
     ba = sp.Matrix([_sp(d.subs({a: 0 for a in ca})) for d in dpcs])
     a_sol = Ka.LUsolve(-ba)
@@ -238,46 +313,97 @@ def _at(e, at):
     return e if not at else e.subs(at)
 
 
-def equilibrium_equations(L, q, qd, at=None) -> sp.Matrix:
-    """Generalised forces at rest, dL/dq at qd = 0 (evaluated at `at`, a partial point).
-    A relative equilibrium is a zero."""
-    Ls = _se(L).subs({v: 0 for v in _se_list(qd)})
+def equilibrium_equations(L, q, qd, at=None, rates=None, Q=None, signals: Sequence = ()) -> sp.Matrix:
+    """Generalised forces at the reference, evaluated at `at` (a partial point): dL/dq + Q
+    at qd = 0 (or at the rates of a steady motion, whose turning coordinates are
+    ignorable), less the explicit time derivative of dL/dqd there. Minus the equations of
+    motion at the reference: a relative equilibrium (a steady motion) is a zero."""
+    ref = {v: 0 for v in _se_list(qd)}
+    ref.update({_se(k): _se(v) for k, v in (rates or {}).items()})
+    Ls = _se(L).subs(ref)
     at_s = {_se(k): _se(v) for k, v in (at or {}).items()}
-    return sp.Matrix([_sp(_at(Ls.diff(qi), at_s)) for qi in _se_list(q)])
+    out = [Ls.diff(qi) for qi in _se_list(q)]
+    explicit = chain(signals)
+    for i, v in enumerate(_se_list(qd)):
+        dp = _partial_time_se(_se(L).diff(v), explicit)
+        if dp != 0:
+            out[i] = out[i] - dp.subs(ref)
+    if Q is not None:
+        out = [o + _se(Qi).subs(ref) for o, Qi in zip(out, Q)]
+    return sp.Matrix([_sp(_at(o, at_s)) for o in out])
 
 
-def quadratic_expansion(L, q, qd, at=None) -> LinearOperator:
-    """Second-order expansion of L(q, qd) about (q0, 0): L2 = qd'M qd/2 + qd'N dq - dq'K dq/2.
+def quadratic_expansion(L, q, qd, at=None, rates=None, signals: Sequence = ()) -> LinearOperator:
+    """Second variation of L(q, qd, t) about (q0, qd0): the accessory Lagrangian
+    L2 = dqd'A dqd/2 + dqd'N dq + dq'C dq/2 with A = L_vv, N = L_vq, C = L_qq there.
 
-    The Lagrange equations of L2 are M dq'' + (N - N') dq' + K dq = 0, so D = N - N' is the
-    skew gyroscopic-and-Coriolis matrix and K the Hessian of the potential. `at` maps some
-    or all coordinates to values (symbols or numbers) after differentiation; the other
-    coordinates stay symbols, so the matrices are functions of the point q.
+    Its Lagrange equations are A dq'' + (N - N' + dA/dt) dq' + (dN/dt - C) dq = 0, so
+    M = A, D = N - N' + dA/dt (skew at rest in a time-independent system: gyroscopic and
+    Coriolis), K = -C + dN/dt. The time derivatives are the explicit ones (t and signals):
+    the reference is rest, or a steady motion whose turning coordinates are ignorable, so
+    nothing else changes along it. `at` maps some or all coordinates to values (symbols or
+    numbers) after differentiation; `rates` maps velocities to their values on the steady
+    motion (zero if absent).
     """
     Ls, qs, vs = _se(L), _se_list(q), _se_list(qd)
-    zero = {v: 0 for v in vs}
+    explicit = chain(signals)
+    ref = {v: 0 for v in vs}
+    ref.update({_se(k): _se(v) for k, v in (rates or {}).items()})
     at_s = {_se(k): _se(v) for k, v in (at or {}).items()}
     grad_v = [Ls.diff(v) for v in vs]
-    Mm = [[_at(gv.diff(w).subs(zero), at_s) for w in vs] for gv in grad_v]
-    grad_v0 = [gv.subs(zero) for gv in grad_v]
-    N = [[_at(gv.diff(qj), at_s) for qj in qs] for gv in grad_v0]
-    L0 = Ls.subs(zero)
+    A = [[gv.diff(w).subs(ref) for w in vs] for gv in grad_v]
+    grad_v0 = [gv.subs(ref) for gv in grad_v]
+    N = [[gv.diff(qj) for qj in qs] for gv in grad_v0]
+    L0 = Ls.subs(ref)
     grad_q = [L0.diff(qi) for qi in qs]
     K = [[-_at(gq.diff(qj), at_s) for qj in qs] for gq in grad_q]
     n = len(qs)
-    D = [[N[i][j] - N[j][i] for j in range(n)] for i in range(n)]
-    conv = lambda A: sp.Matrix(A).applyfunc(_sp)  # noqa: E731
+    D = [[_at(N[i][j], at_s) - _at(N[j][i], at_s) for j in range(n)] for i in range(n)]
+    for i in range(n):
+        for j in range(n):
+            dA, dN = _partial_time_se(A[i][j], explicit), _partial_time_se(N[i][j], explicit)
+            if dA != 0:
+                D[i][j] += _at(dA, at_s)
+            if dN != 0:
+                K[i][j] += _at(dN, at_s)
+    Mm = [[_at(a, at_s) for a in row] for row in A]
+    conv = lambda X: sp.Matrix(X).applyfunc(_sp)  # noqa: E731
     return LinearOperator(conv(Mm), conv(D), conv(K))
 
 
-def linearize_equations(equations, q, qd, qdd, at=None) -> LinearOperator:
-    """Jacobians of the equations E(q, qd, qdd) = 0 at (q0, 0, 0): E ~ M dq'' + D dq' + K dq."""
+def linearize_forces(Q, q, qd, at=None, rates=None) -> tuple:
+    """Jacobians of generalised forces Q(q, qd) at the reference: (dQ/dq, dQ/dqd). Added to
+    an operator as D - dQ/dqd and K - dQ/dq."""
+    Qs, qs, vs = _se_list(Q), _se_list(q), _se_list(qd)
+    ref = {v: 0 for v in vs}
+    ref.update({_se(k): _se(v) for k, v in (rates or {}).items()})
+    at_s = {_se(k): _se(v) for k, v in (at or {}).items()}
+    J = lambda xs: sp.Matrix([[_sp(_at(e.diff(x).subs(ref), at_s)) for x in xs] for e in Qs])  # noqa: E731
+    return J(qs), J(vs)
+
+
+def linearize_equations(equations, q, qd, qdd, at=None, rates=None) -> LinearOperator:
+    """Jacobians of the equations E(q, qd, qdd) = 0 at (q0, qd0, 0): E ~ M dq'' + D dq' + K dq.
+    `rates` maps velocities to their values on a steady motion (zero if absent)."""
     Es = _se_list(equations)
     qs, vs, acc = _se_list(q), _se_list(qd), _se_list(qdd)
-    zero = {v: 0 for v in vs + acc}
+    ref = {v: 0 for v in vs + acc}
+    ref.update({_se(k): _se(v) for k, v in (rates or {}).items()})
     at_s = {_se(k): _se(v) for k, v in (at or {}).items()}
-    J = lambda xs: sp.Matrix([[_sp(_at(e.diff(x).subs(zero), at_s)) for x in xs] for e in Es])  # noqa: E731
+    J = lambda xs: sp.Matrix([[_sp(_at(e.diff(x).subs(ref), at_s)) for x in xs] for e in Es])  # noqa: E731
     return LinearOperator(J(acc), J(vs), J(qs))
+
+
+def input_matrix(equations, inputs, q, qd, qdd, at=None, rates=None) -> sp.Matrix:
+    """B of M q'' + D q' + K q = B w: minus the Jacobian of the equations E in the inputs w
+    at the reference (E = 0 on a motion, so the inputs stand on the right)."""
+    Es = _se_list(equations)
+    vs, acc = _se_list(qd), _se_list(qdd)
+    ref = {v: 0 for v in vs + acc}
+    ref.update({_se(w): 0 for w in inputs})
+    ref.update({_se(k): _se(v) for k, v in (rates or {}).items()})
+    at_s = {_se(k): _se(v) for k, v in (at or {}).items()}
+    return sp.Matrix([[_sp(-_at(e.diff(_se(w)).subs(ref), at_s)) for w in inputs] for e in Es])
 
 
 # --------------------------------------------------------------------------- blocks, polynomials
@@ -348,10 +474,10 @@ def substitute(exprs, mapping) -> list:
     return [_sp(_se(e).subs(m)) for e in exprs]
 
 
-def null_lagrangian_residual(dL, q, qd, qdd) -> list:
+def null_lagrangian_residual(dL, q, qd, qdd, signals: Sequence = ()) -> list:
     """Lagrange equations of a Lagrangian difference, expanded: all zero iff dL is a total
     time derivative plus a constant (it then changes no equation of motion)."""
-    return [_sp(se.expand(e)) for e in _lagrange_se(_se(dL), _se_list(q), _se_list(qd), _se_list(qdd))]
+    return [_sp(se.expand(e)) for e in _lagrange_se(_se(dL), _se_list(q), _se_list(qd), _se_list(qdd), chain(signals))]
 
 
 def numeric_equilibrium(equations, unknowns, values: dict, guess: dict, dps: int = 40) -> dict:
@@ -373,14 +499,14 @@ def numeric_equilibrium(equations, unknowns, values: dict, guess: dict, dps: int
     return dict(zip(unknowns, sol))
 
 
-def integral_rates(L, q, qd, qdd, integrals) -> list:
-    """Time derivatives of candidate first integrals along the Lagrange equations of L:
+def integral_rates(L, q, qd, qdd, integrals, Q=None, signals: Sequence = ()) -> list:
+    """Time derivatives of candidate first integrals along the equations of L with forces Q:
     the accelerations are solved from the mass-matrix form (a small symbolic solve, for a
     proof, never for emission). A first integral's rate simplifies to zero."""
-    Mq, f = mass_matrix_form(L, q, qd)
+    Mq, f = mass_matrix_form(L, q, qd, Q, signals)
     acc = Mq.LUsolve(f)
     sub = dict(zip(qdd, acc))
-    return [time_derivative(I, q, qd, qdd).subs(sub) for I in integrals]
+    return [time_derivative(I, q, qd, qdd, signals).subs(sub) for I in integrals]
 
 
 def root_series(F, x, x0, eps, order: int) -> list:

@@ -1,7 +1,15 @@
-"""What a model is, as data: coordinates, parameters and the functions to emit.
+"""What a model is, as data: coordinates, parameters, energies, forces, signals.
 
-A model file in `derive/models/` builds a `Model`; the machinery in `derive/mechanics.py`
-derives from it and `derive/emit.py` writes it out. A model never knows how it is emitted.
+A model file (in `derive/models/`, or anywhere: `python -m derive --model PATH.py`) builds a
+`Model`; the machinery in `derive/mechanics.py` derives from it, the output kinds in
+`derive/outputs/` turn the derivation into functions, and `derive/emit.py` writes them out.
+A model never knows how it is emitted.
+
+Time is the symbol `TIME` (t): every total time derivative of the machinery includes the
+partial derivative in t, so a Lagrangian or a force may depend on t explicitly. A quantity
+given as a function of time that is not a closed-form expression of t (a base rate u(t), a
+support motion, an applied moment) is a `Signal`: its value and derivatives are symbols
+that the emitted functions take as inputs at each instant.
 """
 from __future__ import annotations
 
@@ -43,6 +51,51 @@ class Parameter:
         if lo is not None and value < lo or hi is not None and value > hi:
             return f"{self.name} ({self.description}) must lie in [{lo}, {hi}] {self.unit}, got {value!r}"
         return None
+
+
+TIME = sp.Symbol("t")  # explicit time in Lagrangians, forces and signals
+
+
+class Unsupported(ValueError):
+    """What the machinery cannot derive (a nonholonomic constraint, a force on a cyclic
+    coordinate, a signal differentiated beyond its declared order): refused at derive time,
+    with a message naming the cause, never derived wrongly."""
+
+
+@dataclass(frozen=True)
+class Signal:
+    """A given function of time: `name`, `name_d`, `name_dd`, ... are its value and its first
+    `order` derivatives, inputs of the emitted functions at each instant.
+
+    `input=True` (an applied moment, a bearing imperfection, a control): an input w of the
+    linearisation, nominally zero; its columns form B in M q'' + (G + D_s) q' + K q = B w.
+    `input=False` (a base rate u(t), a support motion): a time-varying parameter that stays
+    in the linear operator, which is then a function of its values."""
+
+    name: str
+    unit: str
+    description: str
+    input: bool = True
+    order: int = 2
+
+    @property
+    def symbols(self) -> list:
+        return [sp.Symbol(self.name + "_d" * k) for k in range(self.order + 1)]
+
+    @property
+    def symbol(self) -> sp.Symbol:
+        return self.symbols[0]
+
+
+@dataclass(frozen=True)
+class Load:
+    """An applied force on a point, or a moment on a body: `vector` and the `velocity` of its
+    point (the angular velocity of its body, for a moment), in the same components.
+    Its generalised forces are Q_k = vector . d velocity / d qd_k (virtual power)."""
+
+    vector: object
+    velocity: object
+    name: str = ""
 
 
 @dataclass
@@ -103,10 +156,40 @@ class Model:
     variants: dict = field(default_factory=dict)  # name -> Variant
     formulas: dict = field(default_factory=dict)  # name -> SymPy expression in parameters
     formula_docs: dict = field(default_factory=dict)  # name -> equation number and reading
+    # generalised forces beyond the Lagrangian: a Rayleigh dissipation function F(q, qd)
+    # (Q_k = -dF/dqd_k), applied forces and moments (Load), and generalised forces given
+    # directly (coordinate name -> Q_k); any of them may depend on t and on signals
+    dissipation: object = 0
+    loads: list = field(default_factory=list)
+    generalized_forces: dict = field(default_factory=dict)
+    signals: list = field(default_factory=list)  # Signal
+    # a steady motion the model declares: coordinate -> its constant rate (an expression of
+    # the parameters); those coordinates must be ignorable (absent from L and the forces).
+    # The operator is then about q = q0 + rate t, over every coordinate not Routh-reduced.
+    steady: dict = field(default_factory=dict)
+    # constraints between velocities that are not derivatives of coordinate constraints
+    # (rolling, knife edges): the machinery has no multipliers for them and refuses them
+    nonholonomic: list = field(default_factory=list)
+    # model quantities that analyses need, emitted like everything else: name ->
+    # (input groups, outputs [(name, Matrix)], doc); groups among params, q, qd, momenta,
+    # time, signals, and (name, [symbols]) for inputs of the quantity's own
+    quantities: dict = field(default_factory=dict)
     # approximate natural frequencies, one entry per mode: (label, [(formula name, relative
     # error estimate as an expression in the parameters), ...]); the runtime takes, per
     # parameter set and mode, the candidate whose own estimate is smallest
     mode_formulas: list = field(default_factory=list)
+
+    @property
+    def signal_symbols(self) -> list:
+        return [s for sig in self.signals for s in sig.symbols]
+
+    @property
+    def input_signal_symbols(self) -> list:
+        return [s for sig in self.signals if sig.input for s in sig.symbols]
+
+    @property
+    def has_forces(self) -> bool:
+        return bool(self.dissipation != 0 or self.loads or self.generalized_forces)
 
     def param(self, name: str) -> Parameter:
         for p in self.parameters:

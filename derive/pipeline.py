@@ -1,8 +1,10 @@
 """The derivation as a sequence of generic steps over a `Model`, each printed with its time.
 
-model -> identities -> Lagrange equations (1.13) -> Routh reduction of cyclic coordinates ->
-equilibrium equations -> linear operator by two routes (must agree) -> approximate variants
-(printed blocks, characteristic polynomials per block) -> functions to emit.
+model -> checks (what the machinery supports, names) -> identities -> equations of motion
+with generalised forces, explicit time and signals -> Routh reduction of cyclic coordinates
+-> equations of the reference (rest, a relative equilibrium, or a declared steady motion)
+-> linear operator by two routes (must agree) -> input matrix B -> approximate variants ->
+functions to emit, contributed by the output kinds of `derive/outputs/`.
 """
 from __future__ import annotations
 
@@ -15,13 +17,10 @@ from dataclasses import dataclass, field
 import sympy as sp
 
 from derive import mechanics as mech
-from derive.model import Function, Model
+from derive import names
+from derive.model import TIME, Function, Model, Unsupported
 
 P_SYMBOL = sp.Symbol("p")  # the operator d/dt
-# every formula's estimate also carries the rounding of evaluating it in double precision
-# (a few hundred operations): 64 eps
-FORMULA_ROUNDING = sp.Float(2.0**-46)
-MATRICES = ("M", "D", "K", "J", "J_re", "J_im", "Mq")  # outputs that stay matrices when 1x1
 Z_SYMBOL = sp.Symbol("z")  # p^2
 
 
@@ -63,13 +62,43 @@ class Derivation:
     rq: list  # reduced coordinates, velocities, accelerations (operator order)
     rqd: list
     rqdd: list
-    even: list  # reduced coordinates that are not zero at the symmetric equilibrium
-    equilibrium_residual: sp.Matrix  # dR/dq at rest on the symmetric set, function of `even`
-    operator: mech.LinearOperator  # exact, on the symmetric set, function of `even`
+    even: list  # reduced coordinates that are unknowns of the reference (not zero by symmetry)
+    equilibrium_residual: sp.Matrix  # minus the equations at the reference, function of `even`
+    operator: mech.LinearOperator  # exact, at the reference, function of `even`
     route_agreement: float  # max |route1 - route2| / max |route2| at random points
+    order: list = field(default_factory=list)  # names of the reduced coordinates
+    forces: list = field(default_factory=list)  # generalised forces Q, all coordinates
+    rates: dict = field(default_factory=dict)  # velocity symbol -> rate on a steady motion
+    inputs: list = field(default_factory=list)  # w: columns of B (symbols)
+    input_matrix: sp.Matrix | None = None  # B of M q'' + D q' + K q = B w
+    time_dependent: bool = False  # t appears in the Lagrangian or the forces
     variants: dict[str, VariantResult] = field(default_factory=dict)
     functions: list[Function] = field(default_factory=list)
     timings: list = field(default_factory=list)
+
+    @property
+    def momenta(self) -> list:
+        """The cyclic momenta that are inputs (symbols that are not parameters)."""
+        return names.momentum_inputs(self.model)
+
+    @property
+    def driven(self) -> list:
+        """The symbols of the signals that stay in the operator (not inputs w)."""
+        return [s for sig in self.model.signals if not sig.input for s in sig.symbols]
+
+    def state(self, with_qe: bool = True) -> list:
+        """The input groups of everything about the reference: params, qe, momenta, time,
+        the driven signals; each present only when the model has it."""
+        g = [("params", self.model.symbols)]
+        if with_qe:
+            g.append(("qe", self.even))
+        if self.momenta:
+            g.append(("momenta", self.momenta))
+        if self.time_dependent:
+            g.append(("time", [TIME]))
+        if self.driven:
+            g.append(("signals", self.driven))
+        return g
 
 
 def _random_point(symbols, rng):
@@ -94,10 +123,74 @@ def compare_operators(op1: mech.LinearOperator, op2: mech.LinearOperator, points
     return worst
 
 
+def generalized_forces(model: Model) -> list | None:
+    """Q over all coordinates: Rayleigh dissipation, loads by virtual power, and forces given
+    per coordinate. None for a model without forces."""
+    if not model.has_forces:
+        return None
+    n = len(model.coordinates)
+    Q = [sp.Integer(0)] * n
+    if model.dissipation != 0:
+        Q = [a + b for a, b in zip(Q, mech.rayleigh_forces(model.dissipation, model.qd))]
+    for load in model.loads:
+        Q = [a + b for a, b in zip(Q, mech.load_forces(load.vector, load.velocity, model.qd))]
+    for cname, expr in model.generalized_forces.items():
+        if cname not in model.coordinates:
+            raise Unsupported(f"generalised force on {cname!r}, which is not a coordinate")
+        k = model.coordinates.index(cname)
+        Q[k] = Q[k] + sp.sympify(expr)
+    return Q
+
+
+def _check_reducible(model: Model, L0, Q0) -> None:
+    """Routh reduction needs each cyclic coordinate ignorable with a conserved momentum; a
+    steady motion needs its turning coordinates ignorable. Anything else is refused."""
+    if model.nonholonomic:
+        raise Unsupported(f"{model.name}: nonholonomic constraints are not supported (the machinery "
+                          "has no multipliers): write the system in independent coordinates")
+    for cname in list(model.cyclic) + list(model.steady):
+        if cname not in model.coordinates:
+            raise Unsupported(f"{model.name}: {cname!r} is not a coordinate")
+    both = set(model.cyclic) & set(model.steady)
+    if both:
+        raise Unsupported(f"{model.name}: {sorted(both)} both Routh-reduced and turning steadily")
+    signal_syms = set(model.signal_symbols)
+    for cname in list(model.cyclic) + list(model.steady):
+        c, v = model.coordinate(cname), model.velocity(cname)
+        what = "cyclic" if cname in model.cyclic else "turning steadily"
+        if not mech.is_cyclic(L0, c):
+            raise Unsupported(f"{model.name}: {cname} ({what}) appears in the Lagrangian")
+        if Q0 is not None:
+            k = model.coordinates.index(cname)
+            if any(sp.sympify(Qi).has(c) for Qi in Q0):
+                raise Unsupported(f"{model.name}: a generalised force depends on {cname} ({what})")
+            if cname in model.cyclic and (sp.sympify(Q0[k]) != 0 or any(sp.sympify(Qi).has(v) for Qi in Q0)):
+                raise Unsupported(f"{model.name}: a force acts on the cyclic coordinate {cname} or "
+                                  "depends on its rate: its momentum is not conserved; declare a "
+                                  "steady motion of it instead")
+        if cname in model.cyclic:
+            p = sp.diff(model.lagrangian, v)
+            if p.free_symbols & signal_syms & set(model.input_signal_symbols) or any(
+                    p.has(fn) for fn in model.given_functions):
+                raise Unsupported(f"{model.name}: an input enters the momentum of the cyclic {cname}")
+
+
 def derive(model: Model, steps: Steps | None = None) -> Derivation:
     steps = steps or Steps()
     q, qd, qdd = model.q, model.qd, model.qdd
     L = model.lagrangian
+    signals = model.signals
+
+    with steps("checks: names, what the machinery supports"):
+        names.check_model(model)
+        Q = generalized_forces(model)
+        zero_inputs = {s: 0 for s in model.input_signal_symbols}
+        free = {fn: 0 for fn in model.given_functions}  # free vibration
+        L0 = L.subs(free).subs(zero_inputs) if zero_inputs else L.subs(free)
+        Q0 = None if Q is None else [sp.sympify(x).subs(zero_inputs) for x in Q]
+        _check_reducible(model, L0, Q0)
+        time_dependent = TIME in sp.sympify(L).free_symbols or any(
+            TIME in sp.sympify(x).free_symbols for x in (Q or []))
 
     for name, identity in model.identities.items():
         with steps(f"identity: {name}"):
@@ -106,51 +199,54 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
             if bad:
                 raise AssertionError(f"identity failed: {name}: {bad[0]}")
 
-    with steps("Lagrange equations of all coordinates, mass-matrix form"):
-        Mq, f = mech.mass_matrix_form(L, q, qd)
-        inputs = {}
+    with steps("equations of all coordinates, mass-matrix form"):
+        Mq, f = mech.mass_matrix_form(L, q, qd, Q, signals)
+        given = {}
         for fn, val, dval in zip(model.given_functions, model.given_values, model.given_derivatives):
             arg = fn.args[0]
-            inputs[sp.Derivative(fn, arg)] = dval
-            inputs[fn] = val
-        f = sp.Matrix(mech.substitute(list(f), inputs))
+            given[sp.Derivative(fn, arg)] = dval
+            given[fn] = val
+        f = sp.Matrix(mech.substitute(list(f), given))
 
-    free = {fn: 0 for fn in model.given_functions}  # free vibration
-    L0 = L.subs(free)
     R = L0
-    red_names = [c for c in model.coordinates if c not in model.cyclic]
     with steps(f"Routh reduction of the cyclic coordinates {', '.join(model.cyclic)}"):
         for cname, momentum in model.cyclic.items():
-            v = model.velocity(cname)
-            if not mech.is_cyclic(R, model.coordinate(cname)):
-                raise AssertionError(f"{cname} is not cyclic in the free-vibration Lagrangian")
-            R = mech.routhian(R, v, momentum)
+            R = mech.routhian(R, model.velocity(cname), momentum)
 
-    order = model.reduced or red_names
+    order = model.reduced or [c for c in model.coordinates if c not in model.cyclic]
     rq = [model.coordinate(c) for c in order]
     rqd = [model.velocity(c) for c in order]
     rqdd = [model.acceleration(c) for c in order]
-    zero_set = {model.coordinate(c): 0 for c in model.symmetric_zero}
-    even = [x for x, c in zip(rq, order) if c not in model.symmetric_zero]
+    zero_set = {model.coordinate(c): 0 for c in list(model.symmetric_zero) + list(model.steady)}
+    even = [x for x, c in zip(rq, order) if c not in model.symmetric_zero and c not in model.steady]
+    rates = {model.velocity(c): sp.sympify(r) for c, r in model.steady.items()}
+    Q0r = None if Q0 is None else [Q0[model.coordinates.index(c)] for c in order]
 
-    with steps("equilibrium equations and their symmetric zeros"):
-        residual = mech.equilibrium_equations(R, rq, rqd, at=zero_set)
+    with steps("equations of the reference and their symmetric zeros"):
+        residual = mech.equilibrium_equations(R, rq, rqd, at=zero_set, rates=rates, Q=Q0r, signals=signals)
         for c in model.symmetric_zero:
             r = sp.expand(residual[order.index(c)])
             if r != 0:
                 raise AssertionError(f"equilibrium equation of {c} does not vanish on the symmetric set: {r}")
 
-    with steps("linear operator, route 2: second-order expansion of the Routhian"):
-        op2 = mech.quadratic_expansion(R, rq, rqd, at=zero_set)
+    with steps("linear operator, route 2: second variation of the Routhian, forces linearised"):
+        op2 = mech.quadratic_expansion(R, rq, rqd, at=zero_set, rates=rates, signals=signals)
+        if Q0r is not None:
+            Qq, Qv = mech.linearize_forces(Q0r, rq, rqd, at=zero_set, rates=rates)
+            op2 = mech.LinearOperator(op2.M, op2.D - Qv, op2.K - Qq)
+
+    cyc_idx = [model.coordinates.index(c) for c in model.cyclic]
+    names_after = [c for c in model.coordinates if c not in model.cyclic]
+
+    def reduced_equations(Lx, Qx):
+        E = mech.lagrange_equations(Lx, q, qd, qdd, Qx, signals)
+        if model.cyclic:
+            E = mech.eliminate_cyclic(E, q, qd, qdd, cyc_idx, L0, list(model.cyclic.values()), signals)
+        return [E[names_after.index(c)] for c in order]
 
     with steps("linear operator, route 1: linearising the full equations with the integral"):
-        E = mech.lagrange_equations(L0, q, qd, qdd)
-        if model.cyclic:
-            E = mech.eliminate_cyclic(E, q, qd, qdd, [model.coordinates.index(c) for c in model.cyclic],
-                                      L0, list(model.cyclic.values()))
-        names_after = [c for c in model.coordinates if c not in model.cyclic]
-        E = [E[names_after.index(c)] for c in order]
-        op1 = mech.linearize_equations(E, rq, rqd, rqdd, at=zero_set)
+        E = reduced_equations(L0, Q0)
+        op1 = mech.linearize_equations(E, rq, rqd, rqdd, at=zero_set, rates=rates)
 
     with steps("the two routes agree (30 digits, random rational points)"):
         agreement = compare_operators(op1, op2)
@@ -159,7 +255,26 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
 
     deriv = Derivation(model=model, mass_matrix=Mq, forcing=f, routhian=R, rq=rq, rqd=rqd,
                        rqdd=rqdd, even=even, equilibrium_residual=residual, operator=op2,
-                       route_agreement=agreement)
+                       route_agreement=agreement, order=order, forces=Q or [], rates=rates,
+                       time_dependent=time_dependent)
+
+    w = list(model.given_values) + list(model.given_derivatives) + list(model.input_signal_symbols)
+    if w:
+        with steps("input matrix B: the equations' Jacobian in the inputs at the reference"):
+            Lin = (L - L.subs(free)) if model.given_functions else sp.Integer(0)
+            if zero_inputs:
+                Lin = Lin + (L.subs(free) - L0)
+            Lin = mech.substitute([Lin], given)[0] if given else Lin
+            Qin = None if Q is None else [sp.sympify(a) - b for a, b in zip(Q, Q0)]
+            Ein = mech.lagrange_equations(Lin, q, qd, qdd, Qin, signals)
+            Ein = mech.substitute(Ein, given) if given else Ein
+            if model.cyclic:
+                Ein = mech.eliminate_cyclic(Ein, q, qd, qdd, cyc_idx, L0, list(model.cyclic.values()), signals)
+            Ein = [Ein[names_after.index(c)] for c in order]
+            B = mech.input_matrix(Ein, w, rq, rqd, rqdd, at=zero_set, rates=rates)
+            keep = [j for j in range(len(w)) if any(B[i, j] != 0 for i in range(B.rows))]
+            deriv.inputs = [w[j] for j in keep]
+            deriv.input_matrix = B.extract(list(range(B.rows)), keep) if keep else None
 
     for vname, variant in model.variants.items():
         with steps(f"variant '{vname}': approximations, blocks, polynomials per block"):
@@ -177,76 +292,22 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
 
 
 def functions(d: Derivation) -> list[Function]:
-    """The functions to emit for a derived model, with their inputs and outputs."""
-    model = d.model
-    params = ("params", model.symbols)
-    qe = ("qe", d.even)
-    # the cyclic momenta that are not parameters (constants of a motion, e.g. H, L of a
-    # free gyroscope) are an input of everything that comes from the Routh function
-    moms = [s for s in model.cyclic.values() if s not in model.symbols]
-    state = [params, qe] + ([("momenta", moms)] if moms else [])
-    order = model.reduced or [c for c in model.coordinates if c not in model.cyclic]
-    even_names = [str(x) for x in d.even]
-    fns = [
-        Function("equilibrium_residual", state, [("r", d.equilibrium_residual)],
-                 "Generalised forces dR/dq at rest on the symmetric set (R: Routh function); "
-                 f"zero at a relative equilibrium. Rows: {', '.join(order)}."),
-    ]
-    if model.equilibrium_approx:
-        fns.append(Function("equilibrium_approx", [params],
-                            [("qe", sp.Matrix([model.equilibrium_approx[c] for c in even_names]))],
-                            f"Approximate equilibrium (2.2) of {', '.join(even_names)}."))
-    op = d.operator
-    fns.append(Function("operator", state, [("M", op.M), ("D", op.D), ("K", op.K)],
-                        "Exact linear operator about the equilibrium qe: M q'' + D q' + K q = 0 "
-                        f"over q = ({', '.join(order)}); M, K symmetric, D skew.", MATRICES))
-    fns.append(Function("operator_J", state + [("pval", [P_SYMBOL])], [("J", op.J(P_SYMBOL))],
-                        "J(p) = M p^2 + D p + K of the exact operator at a real p.", MATRICES))
-    pr, pi = sp.symbols("p_re p_im")
-    fns.append(Function("operator_J_complex", state + [("pval", [pr, pi])],
-                        [("J_re", op.M * (pr**2 - pi**2) + op.D * pr + op.K),
-                         ("J_im", op.M * (2 * pr * pi) + op.D * pi)],
-                        "J(p) at a complex p = p_re + i p_im, as real and imaginary parts; "
-                        "J(i omega) at p = (0, omega).", MATRICES))
-    for vname, v in d.variants.items():
-        fns.append(Function(f"{vname}_operator", [params],
-                            [("M", v.operator.M), ("D", v.operator.D), ("K", v.operator.K)],
-                            f"Operator of the '{vname}' variant ({model.variants[vname].doc}); "
-                            "rows not scaled.", MATRICES))
-        fns.append(Function(f"{vname}_charpoly", [params],
-                            [(f"block{i + 1}", sp.Matrix(c)) for i, c in enumerate(v.charpoly)],
-                            f"Characteristic polynomial of each diagonal block of the '{vname}' "
-                            "operator: coefficients of det J_block in z = p^2, lowest degree first."))
-    if model.formulas:
-        fns.append(Function("formulas", [params],
-                            [("values", sp.Matrix(list(model.formulas.values())))],
-                            "The paper's approximate formulas, in the order of metadata "
-                            "'formulas'."))
-    if model.mode_formulas:
-        width = max(len(c) for _, c in model.mode_formulas)
-        rows = [c + [c[-1]] * (width - len(c)) for _, c in model.mode_formulas]  # pad: repeat
-        fns.append(Function("mode_formulas", [params],
-                            [("omega", sp.Matrix([[model.formulas[n] for n, _ in r] for r in rows])),
-                             ("estimate", sp.Matrix([[e + FORMULA_ROUNDING for _, e in r] for r in rows]))],
-                            "Approximate natural frequencies, a row per mode (metadata "
-                            "'mode_formulas'), a column per candidate formula, with each "
-                            "candidate's relative error estimate (plus 64 eps of rounding).", MATRICES))
-    fns.append(Function("mass_matrix", [params, ("q", model.q)], [("Mq", d.mass_matrix)],
-                        "Mass matrix of the full nonlinear equations: Mq qdd = f.", MATRICES))
-    given = [("given", model.given_values), ("dgiven", model.given_derivatives),
-             ("constants", model.given_constants)] if model.given_values else []
-    fns.append(Function("forcing", [params, ("q", model.q), ("qd", model.qd)] + given,
-                        [("f", d.forcing)],
-                        "Right-hand side f(q, qd) of the full nonlinear equations, "
-                        "Mq qdd = f, with the given functions' values and derivatives as inputs."))
+    """The functions to emit for a derived model: each output kind of `derive/outputs/`
+    contributes its own, in the kinds' order."""
+    from derive import outputs
+
+    fns = []
+    for kind in outputs.kinds():
+        fns.extend(kind.functions(d))
     return fns
 
 
 def metadata(d: Derivation) -> dict:
     """JSON-serialisable facts the runtime needs without SymPy."""
+    from derive import outputs
+
     model = d.model
-    order = model.reduced or [c for c in model.coordinates if c not in model.cyclic]
-    return {
+    meta = {
         "model": model.name,
         "title": model.title,
         "paper": model.source,
@@ -256,14 +317,13 @@ def metadata(d: Derivation) -> dict:
         "coordinates": model.coordinates,
         "coordinate_units": model.coordinate_units,
         "cyclic": {c: str(s) for c, s in model.cyclic.items()},
-        "momenta": [str(s) for s in model.cyclic.values() if s not in model.symbols],
-        "reduced": order,
+        "momenta": [str(s) for s in d.momenta],
+        "reduced": d.order,
         "equilibrium_coordinates": [str(x) for x in d.even],
         "symmetric_zero": model.symmetric_zero,
         "given": [str(s) for s in model.given_values + model.given_derivatives + model.given_constants],
-        "variants": {name: {"blocks": [[order[i] for i in b] for b in v.blocks]}
-                     for name, v in d.variants.items()},
-        "formulas": [{"name": k, "doc": model.formula_docs.get(k, "")} for k in model.formulas],
-        "mode_formulas": [{"mode": label, "candidates": [n for n, _ in c]} for label, c in model.mode_formulas],
         "route_agreement": d.route_agreement,
     }
+    for kind in outputs.kinds():
+        meta.update(getattr(kind, "metadata", lambda _: {})(d))
+    return meta

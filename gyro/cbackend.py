@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gyro.models import GENERATED, load
+from gyro.models import load
 
 FLAGS = ("-O3", "-march=native", "-std=c99", "-fno-math-errno", "-fPIC", "-shared")
 
@@ -69,7 +69,7 @@ def cache_dir() -> Path:
 @lru_cache(maxsize=None)
 def library(model_name: str) -> ctypes.CDLL:
     """The compiled library of a model's generated C (built on first use)."""
-    src = GENERATED / model_name / f"{model_name}.c"
+    src = load(model_name).directory / f"{model_name}.c"
     hdr = src.with_suffix(".h")
     cc = os.environ.get("CC", "gcc")
     if shutil.which(cc) is None:
@@ -99,8 +99,9 @@ class BatchFunction:
     def __init__(self, model_name: str, fname: str):
         meta = load(model_name).meta["functions"][fname]
         self.name = fname
-        self.in_lens = [len(v) for v in meta["inputs"].values()]
-        self.out_shapes = [tuple(v) for v in meta["outputs"].values()]
+        # the C signature's order: metadata lists inputs and outputs in call order
+        self.in_lens = [len(i["symbols"]) for i in meta["inputs"]]
+        self.out_shapes = [tuple(o["shape"]) for o in meta["outputs"]]
         self._fn = _entry(model_name, f"{model_name}_{fname}_batch")
 
     def __call__(self, *inputs):
@@ -125,7 +126,8 @@ def _entry(model_name: str, symbol: str):
 
 
 def _operator_dim(model_name: str) -> int:
-    return load(model_name).meta["functions"]["operator"]["outputs"]["M"][0]
+    outs = load(model_name).meta["functions"]["operator"]["outputs"]
+    return next(o["shape"][0] for o in outs if o["name"] == "M")
 
 
 def _check(cond: bool, what: str) -> None:

@@ -39,23 +39,41 @@ class Param:
 
 
 class Model:
-    """A generated model: its metadata and its NumPy and CasADi functions."""
+    """A generated model: its metadata and its NumPy and CasADi functions.
 
-    def __init__(self, name: str):
-        known = available()
-        if name not in known:
-            raise ParameterError(f"unknown model {name!r}; known: {', '.join(known)}")
-        pkg = importlib.import_module(f"generated.{name}")
+    `Model(name)` is a model of the repository's generated/; `Model(name, directory)` one
+    that `python -m derive --model PATH.py --out DIR` emitted into directory = DIR/<name>."""
+
+    def __init__(self, name: str, directory: Path | None = None):
+        if directory is None:
+            known = available()
+            if name not in known:
+                raise ParameterError(f"unknown model {name!r}; known: {', '.join(known)}")
+            package = f"generated.{name}"
+            self.directory = GENERATED / name
+        else:
+            self.directory = Path(directory).resolve()
+            if not (self.directory / "metadata.json").exists():
+                raise ParameterError(f"{self.directory}: no generated model there (no metadata.json)")
+            package = _import_directory(self.directory)
+        pkg = importlib.import_module(package)
+        if pkg.METADATA["model"] != name:
+            raise ParameterError(f"{self.directory} holds the model {pkg.METADATA['model']!r}, not {name!r}")
+        self.package = package
         self.name = name
         self.meta = pkg.METADATA
         self.params = [Param(p["name"], p["unit"], p["default"], p["description"], p["kind"],
                              tuple(p["bounds"])) for p in self.meta["parameters"]]
         self.param_names = [p.name for p in self.params]
-        self.numpy = importlib.import_module(f"generated.{name}.numpy_functions")
+        self.numpy = importlib.import_module(f"{package}.numpy_functions")
 
     @cached_property
     def casadi(self):
-        return importlib.import_module(f"generated.{self.name}.casadi_functions")
+        return importlib.import_module(f"{self.package}.casadi_functions")
+
+    @cached_property
+    def mpmath(self):
+        return importlib.import_module(f"{self.package}.mpmath_functions")
 
     @property
     def defaults(self) -> dict[str, float]:
@@ -83,6 +101,22 @@ class Model:
         return np.array([[v[n] for n in self.param_names] for v in batch], dtype=float)
 
 
+def _import_directory(directory: Path) -> str:
+    """Import a generated package from a folder anywhere, under a private name."""
+    import hashlib
+    import importlib.util
+    import sys
+
+    name = "_gyro_model_" + hashlib.sha256(str(directory).encode()).hexdigest()[:12]
+    if name not in sys.modules:
+        spec = importlib.util.spec_from_file_location(name, directory / "__init__.py",
+                                                      submodule_search_locations=[str(directory)])
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    return name
+
+
 def available() -> list[str]:
     """The generated models: folders of generated/ with a metadata.json."""
     return sorted(p.name for p in GENERATED.iterdir() if (p / "metadata.json").exists())
@@ -91,7 +125,17 @@ def available() -> list[str]:
 _CACHE: dict[str, Model] = {}
 
 
-def load(name: str) -> Model:
+def load(name: str | Path) -> Model:
+    """A generated model by name (generated/<name>), or by the folder it was emitted into
+    (a path: DIR/<name> from `python -m derive --model PATH.py --out DIR`); the compiled
+    backend then finds it by its name."""
+    if isinstance(name, Path) or "/" in str(name) or "\\" in str(name):
+        directory = Path(name).resolve()
+        model_name = directory.name
+        known = _CACHE.get(model_name)
+        if known is None or known.directory != directory:
+            _CACHE[model_name] = Model(model_name, directory)
+        return _CACHE[model_name]
     if name not in _CACHE:
         _CACHE[name] = Model(name)
     return _CACHE[name]

@@ -1,0 +1,52 @@
+"""The reference's equations (rest, a relative equilibrium, a steady motion) and the
+model's approximate equilibrium."""
+from __future__ import annotations
+
+import sympy as sp
+
+from derive.model import Function
+
+ORDER = 10
+
+
+def functions(d) -> list[Function]:
+    model = d.model
+    fns = [Function("equilibrium_residual", d.state(), [("r", d.equilibrium_residual)],
+                    "Generalised forces dR/dq at rest on the symmetric set (R: Routh function); "
+                    f"zero at a relative equilibrium. Rows: {', '.join(d.order)}."
+                    + _extra(d))]
+    if model.equilibrium_approx:
+        even_names = [str(x) for x in d.even]
+        fns.append(Function("equilibrium_approx", [("params", model.symbols)],
+                            [("qe", sp.Matrix([model.equilibrium_approx[c] for c in even_names]))],
+                            f"Approximate equilibrium (2.2) of {', '.join(even_names)}."))
+    return fns
+
+
+def _extra(d) -> str:
+    parts = []
+    if d.model.has_forces:
+        parts.append("the generalised forces Q are included")
+    if d.rates:
+        parts.append("on the steady motion " + ", ".join(f"{v} = {r}" for v, r in d.rates.items()))
+    if d.time_dependent or d.model.signals:
+        parts.append("less the explicit time derivative of dR/dqd")
+    return (" With " + "; ".join(parts) + ".") if parts else ""
+
+
+def metadata(d) -> dict:
+    model = d.model
+    meta = {}
+    if model.steady:
+        meta["steady"] = {c: str(r) for c, r in model.steady.items()}
+    if model.signals:
+        meta["signals"] = [{"name": s.name, "unit": s.unit, "description": s.description,
+                            "input": s.input, "symbols": [str(x) for x in s.symbols]}
+                           for s in model.signals]
+    if d.time_dependent:
+        meta["time_dependent"] = True
+    if model.has_forces:
+        meta["forces"] = {"dissipation": str(model.dissipation) if model.dissipation != 0 else None,
+                          "loads": [ld.name for ld in model.loads],
+                          "generalized": sorted(model.generalized_forces)}
+    return meta

@@ -1,0 +1,31 @@
+"""The full nonlinear equations in mass-matrix form, Mq(q) qdd = f(q, qd), for simulation."""
+from __future__ import annotations
+
+from derive.model import TIME, Function
+from derive.outputs.operator import MATRICES
+
+ORDER = 50
+
+
+def functions(d) -> list[Function]:
+    model = d.model
+    params = ("params", model.symbols)
+    timed = ([("time", [TIME])] if d.time_dependent else []) + (
+        [("signals", model.signal_symbols)] if model.signals else [])
+    given = [("given", model.given_values), ("dgiven", model.given_derivatives),
+             ("constants", model.given_constants)] if model.given_values else []
+    extra = []
+    if model.has_forces:
+        extra.append("generalised forces included")
+    if timed:
+        extra.append("the explicit time derivative of dL/dqd moved to f")
+    note = f" ({'; '.join(extra)})" if extra else ""
+    return [
+        Function("mass_matrix", [params, ("q", model.q)] + timed, [("Mq", d.mass_matrix)],
+                 "Mass matrix of the full nonlinear equations: Mq qdd = f.", MATRICES),
+        Function("forcing", [params, ("q", model.q), ("qd", model.qd)] + timed + given,
+                 [("f", d.forcing)],
+                 "Right-hand side f(q, qd) of the full nonlinear equations, "
+                 "Mq qdd = f, with the given functions' values and derivatives as inputs"
+                 + note + "."),
+    ]

@@ -1,0 +1,41 @@
+"""The exact linear operator about the reference: M q'' + D q' + K q = 0, J(p), and for a
+system with forces or explicit time its parts G (skew), D_s (symmetric), K_s, K_c."""
+from __future__ import annotations
+
+import sympy as sp
+
+from derive.model import Function
+
+ORDER = 20
+P_SYMBOL = sp.Symbol("p")
+MATRICES = ("M", "D", "K", "J", "J_re", "J_im", "Mq", "G", "Ds", "Ks", "Kc", "B")
+
+
+def functions(d) -> list[Function]:
+    state, op = d.state(), d.operator
+    coords = ", ".join(d.order)
+    conservative = not (d.model.has_forces or d.time_dependent or d.model.signals)
+    what = ("M, K symmetric, D skew." if conservative else
+            "D = G + D_s (gyroscopic, dissipative), K = K_s + K_c (potential, circulatory).")
+    fns = [Function("operator", state, [("M", op.M), ("D", op.D), ("K", op.K)],
+                    "Exact linear operator about the equilibrium qe: M q'' + D q' + K q = 0 "
+                    f"over q = ({coords}); {what}", MATRICES),
+           Function("operator_J", state + [("pval", [P_SYMBOL])], [("J", op.J(P_SYMBOL))],
+                    "J(p) = M p^2 + D p + K of the exact operator at a real p.", MATRICES)]
+    pr, pi = sp.symbols("p_re p_im")
+    fns.append(Function("operator_J_complex", state + [("pval", [pr, pi])],
+                        [("J_re", op.M * (pr**2 - pi**2) + op.D * pr + op.K),
+                         ("J_im", op.M * (2 * pr * pi) + op.D * pi)],
+                        "J(p) at a complex p = p_re + i p_im, as real and imaginary parts; "
+                        "J(i omega) at p = (0, omega).", MATRICES))
+    if not conservative:
+        half = sp.Rational(1, 2)
+        G, Ds = half * (op.D - op.D.T), half * (op.D + op.D.T)
+        Ks, Kc = half * (op.K + op.K.T), half * (op.K - op.K.T)
+        fns.append(Function("operator_parts", state,
+                            [("G", G.applyfunc(sp.expand)), ("Ds", Ds.applyfunc(sp.expand)),
+                             ("Ks", Ks.applyfunc(sp.expand)), ("Kc", Kc.applyfunc(sp.expand))],
+                            "Parts of the operator: D = G + Ds with G skew (gyroscopic, Coriolis) "
+                            "and Ds symmetric (dissipation), K = Ks + Kc with Ks symmetric "
+                            "(potential) and Kc skew (circulatory).", MATRICES))
+    return fns

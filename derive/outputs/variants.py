@@ -1,0 +1,30 @@
+"""Approximate forms of the operator that a paper prints, and the characteristic
+polynomial of each of their diagonal blocks."""
+from __future__ import annotations
+
+import sympy as sp
+
+from derive.model import Function
+from derive.outputs.operator import MATRICES
+
+ORDER = 30
+
+
+def functions(d) -> list[Function]:
+    model, params = d.model, [("params", d.model.symbols)]
+    fns = []
+    for vname, v in d.variants.items():
+        fns.append(Function(f"{vname}_operator", params,
+                            [("M", v.operator.M), ("D", v.operator.D), ("K", v.operator.K)],
+                            f"Operator of the '{vname}' variant ({model.variants[vname].doc}); "
+                            "rows not scaled.", MATRICES))
+        fns.append(Function(f"{vname}_charpoly", params,
+                            [(f"block{i + 1}", sp.Matrix(c)) for i, c in enumerate(v.charpoly)],
+                            f"Characteristic polynomial of each diagonal block of the '{vname}' "
+                            "operator: coefficients of det J_block in z = p^2, lowest degree first."))
+    return fns
+
+
+def metadata(d) -> dict:
+    return {"variants": {name: {"blocks": [[d.order[i] for i in b] for b in v.blocks]}
+                         for name, v in d.variants.items()}}

@@ -142,7 +142,7 @@ def generalized_forces(model: Model) -> list | None:
     return Q
 
 
-def _check_reducible(model: Model, L0, Q0) -> None:
+def _check_reducible(model: Model, L0, Q0, Q=None) -> None:
     """Routh reduction needs each cyclic coordinate ignorable with a conserved momentum; a
     steady motion needs its turning coordinates ignorable. Anything else is refused."""
     if model.nonholonomic:
@@ -164,7 +164,7 @@ def _check_reducible(model: Model, L0, Q0) -> None:
             k = model.coordinates.index(cname)
             if any(sp.sympify(Qi).has(c) for Qi in Q0):
                 raise Unsupported(f"{model.name}: a generalised force depends on {cname} ({what})")
-            if cname in model.cyclic and (sp.sympify(Q0[k]) != 0 or any(sp.sympify(Qi).has(v) for Qi in Q0)):
+            if cname in model.cyclic and (sp.sympify(Q[k]) != 0 or any(sp.sympify(Qi).has(v) for Qi in Q)):
                 raise Unsupported(f"{model.name}: a force acts on the cyclic coordinate {cname} or "
                                   "depends on its rate: its momentum is not conserved; declare a "
                                   "steady motion of it instead")
@@ -188,7 +188,7 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
         free = {fn: 0 for fn in model.given_functions}  # free vibration
         L0 = L.subs(free).subs(zero_inputs) if zero_inputs else L.subs(free)
         Q0 = None if Q is None else [sp.sympify(x).subs(zero_inputs) for x in Q]
-        _check_reducible(model, L0, Q0)
+        _check_reducible(model, L0, Q0, Q)
         time_dependent = TIME in sp.sympify(L).free_symbols or any(
             TIME in sp.sympify(x).free_symbols for x in (Q or []))
 

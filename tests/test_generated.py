@@ -159,7 +159,13 @@ def test_generated_code_matches_symbolic(name, tmp_path):
     model, _, functions = derived(name)
     lib = compile_c(name, tmp_path)
     rng = random.Random(2024)
+    documented = json.loads((GENERATED / name / "metadata.json").read_text())["functions"]
+    assert list(documented) == sorted(functions)
     for fname, fn in functions.items():
+        # the documented call order is the derivation's: the calls below follow metadata
+        assert [(i["name"], i["symbols"]) for i in documented[fname]["inputs"]] == \
+            [(g, [str(s) for s in syms]) for g, syms in fn.inputs], fname
+        assert [o["name"] for o in documented[fname]["outputs"]] == [o for o, _ in fn.outputs], fname
         shapes = [(mat.rows, mat.cols) for _, mat in fn.outputs]
         points, singles = [], []
         for k in range(N_POINTS):

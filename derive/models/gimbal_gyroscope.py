@@ -103,6 +103,59 @@ def integrals_are_conserved():
     return [sp.simplify(r) for r in out]
 
 
+def routh_function():
+    """Routh's function U1(theta) = U - (L - H cos theta)^2 / (2 (A0 - C0 cos^2 theta)) (3.3):
+    psi' eliminated through L; at C0 = 0 the printed -P1 eta20 sin - G cos - (L - H cos)^2/2A0."""
+    return force_function() - (L - H * sp.cos(theta))**2 / (2 * (A0 - C0 * sp.cos(theta)**2))
+
+
+# initial conditions of a motion at t = 0 (the closed form's inputs)
+theta0, dtheta0, dpsi0, dphi0 = sp.symbols("theta0 dtheta0 dpsi0 dphi0")
+
+
+def closed_form_coefficients():
+    """b0..b4 of (ds/dtau)^2 = b0 + 4 b1 s + 6 b2 s^2 + 4 b3 s^3 + b4 s^4 (section 2,
+    s = tan((theta - theta0)/2)), the invariants g2, g3 of wp (2.6), and H, L, at the
+    initial conditions; C0 = 0 (the closed form's assumption)."""
+    s0, c0 = sp.sin(theta0), sp.cos(theta0)
+    Hm = A3 * (dphi0 + dpsi0 * c0)
+    a, g, h = A0 * P1 * eta20, A0 * (G - Hm * dpsi0), Hm**2
+    b0 = A0 * B0 * dtheta0**2
+    b1 = g * s0 - a * c0
+    b2 = (b0 + 2 * a * s0 + 2 * g * c0 - 2 * h * s0**2) / 3
+    b3 = g * s0 - a * c0 - 2 * h * s0 * c0
+    b4 = b0 + 4 * a * s0 + 4 * g * c0 - 4 * h * c0**2
+    g2 = b0 * b4 - 4 * b1 * b3 + 3 * b2**2
+    g3 = b0 * b2 * b4 - b1**2 * b4 - b2**3 - b0 * b3**2 + 2 * b1 * b2 * b3
+    return sp.Matrix([b0, b1, b2, b3, b4]), g2, g3, Hm, A0 * dpsi0 + Hm * c0
+
+
+def quantities():
+    """What the runtime's analyses need, emitted rather than retyped: G (1.1), the integrals,
+    Routh's U1 with its derivatives, and the closed form's coefficients."""
+    I = integrals()
+    M_int = 2 * I["E"] - I["H"]**2 / A3  # the printed M of (1.2), an integral for any C0
+    U1 = routh_function()
+    b, g2, g3, Hm, Lm = closed_form_coefficients()
+    return {
+        "gravity_moment": (["params"], [("G", sp.Matrix([G]))], "G = P1 eta30 + P l (1.1)."),
+        "first_integrals": (["params", "q", "qd"],
+                            [("values", sp.Matrix([I["H"], I["L"], M_int, I["E"]]))],
+                            "First integrals (1.2) along a state: H, L, M = 2E - H^2/A3 (the "
+                            "printed A0 psi'^2 + B0 theta'^2 + 2 P1 eta20 sin + 2 G cos at C0 = 0), "
+                            "and the energy E = T - U."),
+        "routh_function": (["params", "qe", "momenta"],
+                           [("U1", sp.Matrix([U1, sp.diff(U1, theta), sp.diff(U1, theta, 2)]))],
+                           "Routh's function U1(theta) (3.3) and its first and second derivatives "
+                           "in theta: a stationary motion has U1' = 0, a stable one U1'' < 0."),
+        "closed_form": (["params", ("initial", [theta0, dtheta0, dpsi0, dphi0])],
+                        [("b", b), ("g", sp.Matrix([g2, g3])), ("HL", sp.Matrix([Hm, Lm]))],
+                        "Section 2 at C0 = 0: b0..b4 of (ds/dtau)^2, the invariants g2, g3 of "
+                        "wp in (2.6), and the momenta H, L, at the initial conditions "
+                        "theta0, theta0', psi0', phi0'."),
+    }
+
+
 def build():
     from derive.model import Model
 
@@ -114,4 +167,5 @@ def build():
         cyclic={"phi": H, "psi": L},
         reduced=["theta"],
         identities={"first integrals (1.2): H, L and the energy are conserved": integrals_are_conserved},
+        quantities=quantities(),
     )

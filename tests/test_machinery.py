@@ -1,0 +1,297 @@
+"""The machinery's guarantees: explicit time is never dropped, emitted functions are called in
+their documented order by every backend, what cannot be derived is refused at derive time
+with a message naming the cause, bad names never reach the compiler, and one model's
+generated files depend on the shared machinery and on that model alone."""
+from __future__ import annotations
+
+import ctypes
+import inspect
+import io
+import json
+import re
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from derive import mechanics as mech
+from derive import pipeline
+from derive.model import TIME, Load, Model, Parameter, Signal, Unsupported
+from tests.conftest import GENERATED, ROOT
+
+MODELS = sorted(p.name for p in GENERATED.iterdir() if (p / "metadata.json").exists())
+
+
+# --------------------------------------------------------------------- explicit time
+
+
+def test_time_derivative_includes_the_partial_derivative_in_t():
+    """d/dt [a sin(w t) cos q] = a w cos(w t) cos q - a sin(w t) sin q q'."""
+    q, qd, a, w = sp.symbols("q q_d a w")
+    e = a * sp.sin(w * TIME) * sp.cos(q)
+    want = a * w * sp.cos(w * TIME) * sp.cos(q) - a * sp.sin(w * TIME) * sp.sin(q) * qd
+    assert sp.simplify(mech.time_derivative(e, [q], [qd]) - want) == 0
+
+
+def test_pendulum_on_a_moving_support_keeps_the_support_acceleration():
+    """Pendulum of length l hanging from a support at height a sin(w t): the true equation is
+    m l^2 q'' + m l (g - a w^2 sin(w t)) sin q = 0. Dropping d/dt|explicit would leave out
+    a l m w^2 sin(w t) sin q ... the term the old machinery lost."""
+    q, qd, qdd, m, l, g, a, w = sp.symbols("q q_d q_dd m l g a w")
+    z = a * sp.sin(w * TIME)
+    x, y = l * sp.sin(q), z - l * sp.cos(q)
+    vx, vy = (mech.time_derivative(c, [q], [qd]) for c in (x, y))
+    L = m * (vx**2 + vy**2) / 2 - m * g * y
+    (E,) = mech.lagrange_equations(L, [q], [qd], [qdd])
+    assert sp.simplify(E - (m * l**2 * qdd + m * l * (g - a * w**2 * sp.sin(w * TIME)) * sp.sin(q))) == 0
+    Mq, f = mech.mass_matrix_form(L, [q], [qd])
+    assert sp.simplify(Mq[0, 0] * qdd - f[0] - E) == 0
+
+
+def test_signal_rungs_are_chained_and_an_undeclared_rung_is_refused():
+    s = Signal("zs", "m", "support height", input=False, order=1)
+    q, qd = sp.symbols("q q_d")
+    zs, zs_d = s.symbols
+    assert mech.time_derivative(zs * q, [q], [qd], signals=[s]) == zs_d * q + zs * qd
+    with pytest.raises(Unsupported, match="zs_d"):
+        mech.time_derivative(zs_d, [q], [qd], signals=[s])
+
+
+# --------------------------------------------------------------------- small models
+
+
+def _oscillator(**kw) -> Model:
+    """m x'' + c x' + k x = 0 with a force signal: the smallest model with every input kind."""
+    m, c, k = sp.symbols("m c k")
+    x, xd, xdd = sp.symbols("x x_d x_dd")
+    params = [Parameter("m", "kg", 1.0, "mass"), Parameter("c", "N s/m", 0.1, "damping"),
+              Parameter("k", "N/m", 4.0, "stiffness")]
+    base = dict(name="probe", title="probe", source="test", module=__name__, parameters=params,
+                coordinates=["x"], coordinate_units={"x": "m"}, q=[x], qd=[xd], qdd=[xdd],
+                lagrangian=m * xd**2 / 2 - k * x**2 / 2, dissipation=c * xd**2 / 2,
+                symmetric_zero=["x"])
+    base.update(kw)
+    return Model(**base)
+
+
+def _derive(model):
+    return pipeline.derive(model, pipeline.Steps(out=io.StringIO()))
+
+
+def test_damped_oscillator_operator_and_its_parts():
+    d = _derive(_oscillator())
+    m, c, k = sp.symbols("m c k")
+    assert (d.operator.M, d.operator.D, d.operator.K) == (sp.Matrix([[m]]), sp.Matrix([[c]]), sp.Matrix([[k]]))
+    names = [f.name for f in pipeline.functions(d)]
+    assert "operator_parts" in names and "input_matrix" not in names
+
+
+def test_input_signal_gives_the_input_matrix():
+    F = Signal("Fx", "N", "applied force")
+    d = _derive(_oscillator(signals=[F], generalized_forces={"x": F.symbol}))
+    assert d.inputs == [F.symbol] and d.input_matrix == sp.Matrix([[1]])
+
+
+@pytest.mark.parametrize("bad, match", [
+    ({"coordinates": ["q"], "q": [sp.Symbol("q")], "qd": [sp.Symbol("q_d")], "qdd": [sp.Symbol("q_dd")],
+      "coordinate_units": {"q": "m"}, "symmetric_zero": ["q"]}, "coordinate 'q'"),
+    ({"parameters": [Parameter("params", "kg", 1.0, "mass")]}, "parameter 'params'"),
+    ({"parameters": [Parameter("t3", "kg", 1.0, "mass")]}, "parameter 't3'"),
+    ({"parameters": [Parameter("double", "kg", 1.0, "mass")]}, "parameter 'double'"),
+    ({"parameters": [Parameter("t", "s", 1.0, "a time")]}, "t is time"),
+    ({"signals": [Signal("sqrt", "N", "force")]}, "signal 'sqrt'"),
+    ({"nonholonomic": ["rolling"]}, "nonholonomic"),
+    ({"cyclic": {"x": sp.Symbol("px")}, "lagrangian": sp.Symbol("m") * sp.Symbol("x_d")**2 / 2},
+     "force acts on the cyclic coordinate x"),
+    ({"steady": {"x": 1}}, "x \\(turning steadily\\) appears in the Lagrangian"),
+    ({"generalized_forces": {"y": 1}}, "'y', which is not a coordinate"),
+])
+def test_what_cannot_be_derived_is_refused_naming_it(bad, match):
+    with pytest.raises(Unsupported, match=match):
+        _derive(_oscillator(**bad))
+
+
+def test_a_load_whose_velocity_is_not_affine_in_the_rates_is_refused():
+    x, xd = sp.symbols("x x_d")
+    with pytest.raises(Unsupported, match="not affine"):
+        _derive(_oscillator(loads=[Load(sp.Matrix([1]), sp.Matrix([xd**2]))]))
+    assert mech.load_forces(sp.Matrix([2, 0]), sp.Matrix([xd * sp.cos(x), xd * sp.sin(x)]), [xd]) == [2 * sp.cos(x)]
+
+
+def _write_model(path, body: str):
+    path.write_text(textwrap.dedent(body))
+    return path
+
+
+MODEL_FILE = '''
+    import sympy as sp
+    from derive.model import Model, Parameter, Signal
+
+    NAME = "{name}"
+    x, xd, xdd = sp.symbols("x x_d x_dd")
+    th, thd, thdd = sp.symbols("th th_d th_dd")
+
+
+    def build():
+        m, k, c = sp.symbols("m k c")
+        tau = Signal("tau", "N m", "torque on the wheel")
+        return Model(
+            name=NAME, title="cart with a wheel", source="test", module=__name__,
+            parameters=[Parameter("m", "kg", 1.0, "mass"), Parameter("k", "N/m", 1.0, "spring"),
+                        Parameter("c", "N s/m", 0.1, "damper")],
+            coordinates=["x", "th"], coordinate_units={{"x": "m", "th": "rad"}},
+            q=[x, th], qd=[xd, thd], qdd=[xdd, thdd],
+            lagrangian=m * xd**2 / 2 + m * thd**2 / 4 - k * x**2 / 2,
+            dissipation=c * xd**2 / 2, signals=[tau], generalized_forces={{"th": tau.symbol}},
+            cyclic={{"th": {momentum}}}, symmetric_zero=["x"])
+'''
+
+
+def test_model_anywhere_with_a_zero_momentum_and_empty_inputs_compiles_pedantic(tmp_path):
+    """A model file outside the repository, a cyclic momentum given as 0 (a constant, not an
+    input) and no equilibrium unknowns (qe empty): derived, emitted, and its C compiles under
+    -std=c99 -Wall -Wextra -Werror -pedantic. A force on the cyclic coordinate is refused."""
+    src = _write_model(tmp_path / "wheel_cart.py", MODEL_FILE.format(name="wheel_cart", momentum="0"))
+    proc = subprocess.run([sys.executable, "-m", "derive", "--model", str(src), "--out", str(tmp_path / "out")],
+                          cwd=ROOT, capture_output=True, text=True)
+    assert proc.returncode == 2 and "force acts on the cyclic coordinate th" in proc.stderr
+    assert proc.stderr.count("\n") >= 1 and "Traceback" not in proc.stderr
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
+    src.write_text(src.read_text().replace(', generalized_forces={"th": tau.symbol}', ""))
+    proc = subprocess.run([sys.executable, "-m", "derive", "--model", str(src), "--out", str(tmp_path / "out")],
+                          cwd=ROOT, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    gen = tmp_path / "out" / "wheel_cart"
+    meta = json.loads((gen / "metadata.json").read_text())
+    assert meta["momenta"] == [] and meta["equilibrium_coordinates"] == []
+    assert [i["name"] for i in meta["functions"]["operator"]["inputs"]] == ["params", "qe"]
+    assert "wheel_cart.py" in (gen / "wheel_cart.c").read_text().splitlines()[1]
+    lib = tmp_path / "lib.so"
+    cc = subprocess.run(["gcc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2", "-shared",
+                         "-fPIC", "-o", str(lib), str(gen / "wheel_cart.c"), "-lm"], capture_output=True, text=True)
+    assert cc.returncode == 0, cc.stderr
+    # the operator through C in the documented order: M = m, D = c (the wheel's row is gone)
+    fn = ctypes.CDLL(str(lib)).wheel_cart_operator
+    P = (ctypes.c_double * 3)(2.0, 3.0, 0.5)
+    outs = [(ctypes.c_double * 1)() for _ in range(3)]
+    fn(P, (ctypes.c_double * 1)(), *outs)
+    assert [o[0] for o in outs] == [2.0, 0.5, 3.0]
+
+
+@pytest.mark.parametrize("body, match", [
+    ("x = 1\n", "defines no build"),
+    ("def build():\n    return 42\n", "returned int"),
+    ("import no_such_module_here\n", "importing it failed: ModuleNotFoundError"),
+])
+def test_a_file_that_is_not_a_model_exits_2_in_one_line(tmp_path, body, match):
+    src = _write_model(tmp_path / "notamodel.py", body)
+    proc = subprocess.run([sys.executable, "-m", "derive", "--model", str(src), "--out", str(tmp_path / "out")],
+                          cwd=ROOT, capture_output=True, text=True)
+    assert proc.returncode == 2 and match in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "out").exists()
+
+
+# --------------------------------------------------------------------- call order
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_every_backend_declares_the_documented_argument_order(name):
+    """metadata.json lists each function's inputs in call order; the C prototypes, the NumPy
+    signatures and the CasADi input names are that order."""
+    import importlib
+
+    meta = json.loads((GENERATED / name / "metadata.json").read_text())["functions"]
+    header = (GENERATED / name / f"{name}.h").read_text()
+    nf = importlib.import_module(f"generated.{name}.numpy_functions")
+    cf = importlib.import_module(f"generated.{name}.casadi_functions")
+    for fname, f in meta.items():
+        order = [i["name"] for i in f["inputs"]]
+        proto = re.search(rf"void {name}_{fname}\(([^)]*)\);", header).group(1)
+        assert re.findall(r"const double \*(\w+)", proto) == order, fname
+        assert re.findall(r"double \*out_(\w+)", proto) == [o["name"] for o in f["outputs"]], fname
+        assert list(inspect.signature(getattr(nf, fname)).parameters) == order, fname
+        assert getattr(cf, fname).name_in() == order, fname
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_compiled_batch_functions_agree_with_numpy_on_every_function(name):
+    """gyro.cbackend reads the argument lengths from metadata: every function through C over
+    a batch equals NumPy (the gimbal operator once came back with M = 0.2 for 0.015)."""
+    from gyro import cbackend
+    from gyro.models import load
+
+    model = load(name)
+    meta = model.meta["functions"]
+    rng = np.random.default_rng(7)
+    P = model.vector(model.defaults)
+    for fname, f in meta.items():
+        args = []
+        for i in f["inputs"]:
+            k = len(i["symbols"])
+            args.append(np.tile(P, (3, 1)) * rng.uniform(0.9, 1.1, (3, k)) if i["name"] == "params"
+                        else rng.uniform(-0.5, 0.5, (3, k)) + (0.3 if i["name"] in ("momenta",) else 0))
+        got = cbackend.batch_function(name, fname)(*args)
+        want = getattr(model.numpy, fname)(*args)
+        want = list(want) if isinstance(want, tuple) else [want]
+        for g, w in zip(got, want):
+            np.testing.assert_allclose(g, np.asarray(w).reshape(g.shape), rtol=1e-12, atol=1e-300, err_msg=fname)
+
+
+# --------------------------------------------------------------------- input hash
+
+
+def test_a_models_input_hash_covers_the_machinery_and_itself_only():
+    from derive import emit
+
+    files = emit.machinery_files()
+    assert files and not [f for f in files if "models" in f.relative_to(ROOT).parts]
+    assert {f.suffix for f in files} == {".py", ".j2"}
+    tg = ROOT / "derive" / "models" / "torsion_gyrocompass.py"
+    before = emit.input_hash(tg)
+    probe = ROOT / "derive" / "models" / "zz_probe_model.py"
+    try:
+        probe.write_text("# a new model beside the others\n")
+        assert emit.input_hash(tg) == before
+    finally:
+        probe.unlink()
+    meta = json.loads((GENERATED / "torsion_gyrocompass" / "metadata.json").read_text())
+    assert meta["generated"]["input_hash"] == before
+
+
+def test_models_are_found_without_a_list():
+    from derive.models import MODELS as found
+
+    on_disk = {p.stem for p in (ROOT / "derive" / "models").glob("*.py") if not p.stem.startswith("_")}
+    assert set(found) == on_disk and set(MODELS) <= set(found)
+
+
+# --------------------------------------------------------------------- emitted model quantities
+
+
+def test_gimbal_quantities_are_emitted_and_agree_with_the_runtime():
+    from gyro import gimbal
+    from gyro.models import load
+
+    model = load("gimbal_gyroscope")
+    p = model.defaults
+    P = model.vector(p)
+    q, qd = np.array([0.3, 1.1, -0.2]), np.array([0.7, -0.4, 150.0])
+    H, L, M, E = model.numpy.first_integrals(P, q, qd)
+    ref = gimbal.integrals(p, q, qd)
+    np.testing.assert_allclose([H, L, M], [ref["H"], ref["L"], ref["M"]], rtol=1e-13)
+    assert model.numpy.gravity_moment(P)[0] == pytest.approx(p["P1"] * p["eta30"] + p["P"] * p["l"], rel=1e-15)
+    motion = gimbal.Motion(p, 1.2, 0.3, 1.0, 200.0)
+    cf = gimbal.ClosedForm(motion)
+    b, g, HL = model.numpy.closed_form(P, [1.2, 0.3, 1.0, 200.0])
+    np.testing.assert_allclose(b, cf.b, rtol=1e-9)
+    np.testing.assert_allclose(g, [cf.g2, cf.g3], rtol=1e-9)
+    np.testing.assert_allclose(HL, [cf.H, cf.L], rtol=1e-13)
+    th0 = 1.2
+    stat = gimbal.stationary_motion(p, th0, 2.0)
+    I = stat.integrals0
+    U1, dU1, d2U1 = model.numpy.routh_function(P, [th0], [I["H"], I["L"]])
+    assert abs(dU1) < 1e-12 * (abs(U1) + 1)  # a stationary motion: U1' = 0
+    assert d2U1 == pytest.approx(gimbal.U1_second(p, th0, I["H"], I["L"]), rel=1e-12)

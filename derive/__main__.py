@@ -91,7 +91,8 @@ def main(argv=None) -> int:
             with steps("emit: CSE, CasADi, NumPy, mpmath, C through the templates"):
                 files = emit.emit(model, fns, pipeline.metadata(deriv), out / model.name)
         except (Unsupported, NotAModel) as exc:
-            print(f"derive: {name}: {exc}", file=sys.stderr)
+            msg = str(exc) if str(exc).startswith(f"{name}: ") else f"{name}: {exc}"
+            print(f"derive: {msg}", file=sys.stderr)
             return 2
         print(f"[{name}] {len(files)} files in {out / model.name}; {steps.total:.1f} s", file=sys.stderr)
     (out / "__init__.py").write_text(emit.environment().get_template("generated_init.py.j2").render())

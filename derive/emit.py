@@ -317,7 +317,8 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
     meta["functions"] = {
         f.name: {"doc": f.doc,
                  "inputs": [{"name": i.name, "symbols": i.symbols} for i in f.inputs],
-                 "outputs": [{"name": o.name, "shape": [o.rows, o.cols]} for o in f.outputs],
+                 "outputs": [{"name": o.name, "shape": [o.rows, o.cols], "vector": o.vector}
+                             for o in f.outputs],
                  "ops": f.ops, "ops_before_cse": f.ops_before}
         for f in emitted["numpy"]}
     path = outdir / "metadata.json"

@@ -80,7 +80,7 @@ class Signal:
 
     @property
     def symbols(self) -> list:
-        return [sp.Symbol(self.name + "_d" * k) for k in range(self.order + 1)]
+        return [sp.Symbol(self.name + ("_" + "d" * k if k else "")) for k in range(self.order + 1)]
 
     @property
     def symbol(self) -> sp.Symbol:

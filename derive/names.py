@@ -62,12 +62,12 @@ def check_model(model: Model) -> None:
     the time symbol used for time only."""
     bad = problem(model.name) if model.name not in TEMPLATE_NAMES else "a name the generated code uses"
     if bad:
-        raise Unsupported(f"model name {model.name!r}: {bad}")
+        raise Unsupported(f"{model.name}: the model's name cannot be emitted: {bad}")
     seen = {}
     for what, s in model_symbols(model):
         name = str(s)
         if s == TIME:
-            raise Unsupported(f"{what} {name!r}: t is time, reserved for explicit time")
+            raise Unsupported(f"{model.name}: {what} {name!r}: t is time, reserved for explicit time")
         why = problem(name)
         if why:
             raise Unsupported(f"{model.name}: {what} {name!r} cannot be emitted: {why}")

@@ -209,7 +209,8 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
         f = sp.Matrix(mech.substitute(list(f), given))
 
     R = L0
-    with steps(f"Routh reduction of the cyclic coordinates {', '.join(model.cyclic)}"):
+    with steps(f"Routh reduction of the cyclic coordinates {', '.join(model.cyclic)}" if model.cyclic
+               else "Routh reduction: no cyclic coordinates"):
         for cname, momentum in model.cyclic.items():
             R = mech.routhian(R, model.velocity(cname), momentum)
 

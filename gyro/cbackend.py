@@ -102,16 +102,22 @@ class BatchFunction:
         # the C signature's order: metadata lists inputs and outputs in call order
         self.in_lens = [len(i["symbols"]) for i in meta["inputs"]]
         self.out_shapes = [tuple(o["shape"]) for o in meta["outputs"]]
+        # the NumPy backend's shapes: a column is a vector unless the model says matrix
+        self.out_vector = [o.get("vector", o["shape"][1] == 1) for o in meta["outputs"]]
         self._fn = _entry(model_name, f"{model_name}_{fname}_batch")
 
     def __call__(self, *inputs):
-        n = max(np.asarray(x).reshape(-1, k).shape[0] for x, k in zip(inputs, self.in_lens))
+        if len(inputs) != len(self.in_lens):
+            raise ValueError(f"{self.name}: {len(self.in_lens)} inputs, got {len(inputs)}")
+        sets = [np.asarray(x, dtype=float).reshape(-1, k).shape[0] for x, k in zip(inputs, self.in_lens) if k]
+        n = max(sets, default=1)
         args = [np.ascontiguousarray(np.broadcast_to(np.asarray(x, dtype=float).reshape(-1, k), (n, k)))
-                for x, k in zip(inputs, self.in_lens)]
+                if k else np.zeros((n, 0)) for x, k in zip(inputs, self.in_lens)]
         outs = [np.empty((n, r * c)) for r, c in self.out_shapes]
         ptr = ctypes.POINTER(ctypes.c_double)
         self._fn(ctypes.c_long(n), *[a.ctypes.data_as(ptr) for a in args + outs])
-        return [o.reshape((n, r) if c == 1 else (n, r, c)) for o, (r, c) in zip(outs, self.out_shapes)]
+        return [o.reshape((n, r) if vec else (n, r, c))
+                for o, (r, c), vec in zip(outs, self.out_shapes, self.out_vector)]
 
 
 def _entry(model_name: str, symbol: str):

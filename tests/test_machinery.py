@@ -179,6 +179,14 @@ def test_model_anywhere_with_a_zero_momentum_and_empty_inputs_compiles_pedantic(
     outs = [(ctypes.c_double * 1)() for _ in range(3)]
     fn(P, (ctypes.c_double * 1)(), *outs)
     assert [o[0] for o in outs] == [2.0, 0.5, 3.0]
+    # the runtime's compiled batch call with the empty qe, in NumPy's shapes (1x1 matrices)
+    from gyro import cbackend
+    from gyro.models import load
+
+    model = load(gen)
+    M, D, K = cbackend.batch_function("wheel_cart", "operator")([[2.0, 3.0, 0.5]] * 2, np.empty((2, 0)))
+    assert M.shape == (2, 1, 1) and model.numpy.operator([2.0, 3.0, 0.5], [])[0].shape == (1, 1)
+    np.testing.assert_array_equal(np.concatenate([M, D, K], axis=1)[:, :, 0], [[2.0, 0.5, 3.0]] * 2)
 
 
 @pytest.mark.parametrize("body, match", [

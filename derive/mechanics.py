@@ -313,15 +313,22 @@ def _at(e, at):
     return e if not at else e.subs(at)
 
 
+def _reference(zero, rates=None, at=None):
+    """(velocities and the like -> their values on the reference, coordinates -> `at`), in
+    SymEngine: `zero` symbols are 0 (velocities at rest, accelerations, inputs), `rates` the
+    velocities of a steady motion, `at` a partial point of the coordinates."""
+    ref = {_se(v): se.Integer(0) for v in zero}
+    ref.update({_se(k): _se(v) for k, v in (rates or {}).items()})
+    return ref, {_se(k): _se(v) for k, v in (at or {}).items()}
+
+
 def equilibrium_equations(L, q, qd, at=None, rates=None, Q=None, signals: Sequence = ()) -> sp.Matrix:
     """Generalised forces at the reference, evaluated at `at` (a partial point): dL/dq + Q
     at qd = 0 (or at the rates of a steady motion, whose turning coordinates are
     ignorable), less the explicit time derivative of dL/dqd there. Minus the equations of
     motion at the reference: a relative equilibrium (a steady motion) is a zero."""
-    ref = {v: 0 for v in _se_list(qd)}
-    ref.update({_se(k): _se(v) for k, v in (rates or {}).items()})
+    ref, at_s = _reference(qd, rates, at)
     Ls = _se(L).subs(ref)
-    at_s = {_se(k): _se(v) for k, v in (at or {}).items()}
     out = [Ls.diff(qi) for qi in _se_list(q)]
     explicit = chain(signals)
     for i, v in enumerate(_se_list(qd)):
@@ -347,9 +354,7 @@ def quadratic_expansion(L, q, qd, at=None, rates=None, signals: Sequence = ()) -
     """
     Ls, qs, vs = _se(L), _se_list(q), _se_list(qd)
     explicit = chain(signals)
-    ref = {v: 0 for v in vs}
-    ref.update({_se(k): _se(v) for k, v in (rates or {}).items()})
-    at_s = {_se(k): _se(v) for k, v in (at or {}).items()}
+    ref, at_s = _reference(vs, rates, at)
     grad_v = [Ls.diff(v) for v in vs]
     A = [[gv.diff(w).subs(ref) for w in vs] for gv in grad_v]
     grad_v0 = [gv.subs(ref) for gv in grad_v]
@@ -375,9 +380,7 @@ def linearize_forces(Q, q, qd, at=None, rates=None) -> tuple:
     """Jacobians of generalised forces Q(q, qd) at the reference: (dQ/dq, dQ/dqd). Added to
     an operator as D - dQ/dqd and K - dQ/dq."""
     Qs, qs, vs = _se_list(Q), _se_list(q), _se_list(qd)
-    ref = {v: 0 for v in vs}
-    ref.update({_se(k): _se(v) for k, v in (rates or {}).items()})
-    at_s = {_se(k): _se(v) for k, v in (at or {}).items()}
+    ref, at_s = _reference(vs, rates, at)
     J = lambda xs: sp.Matrix([[_sp(_at(e.diff(x).subs(ref), at_s)) for x in xs] for e in Qs])  # noqa: E731
     return J(qs), J(vs)
 
@@ -387,9 +390,7 @@ def linearize_equations(equations, q, qd, qdd, at=None, rates=None) -> LinearOpe
     `rates` maps velocities to their values on a steady motion (zero if absent)."""
     Es = _se_list(equations)
     qs, vs, acc = _se_list(q), _se_list(qd), _se_list(qdd)
-    ref = {v: 0 for v in vs + acc}
-    ref.update({_se(k): _se(v) for k, v in (rates or {}).items()})
-    at_s = {_se(k): _se(v) for k, v in (at or {}).items()}
+    ref, at_s = _reference(vs + acc, rates, at)
     J = lambda xs: sp.Matrix([[_sp(_at(e.diff(x).subs(ref), at_s)) for x in xs] for e in Es])  # noqa: E731
     return LinearOperator(J(acc), J(vs), J(qs))
 
@@ -399,10 +400,7 @@ def input_matrix(equations, inputs, q, qd, qdd, at=None, rates=None) -> sp.Matri
     at the reference (E = 0 on a motion, so the inputs stand on the right)."""
     Es = _se_list(equations)
     vs, acc = _se_list(qd), _se_list(qdd)
-    ref = {v: 0 for v in vs + acc}
-    ref.update({_se(w): 0 for w in inputs})
-    ref.update({_se(k): _se(v) for k, v in (rates or {}).items()})
-    at_s = {_se(k): _se(v) for k, v in (at or {}).items()}
+    ref, at_s = _reference(vs + acc + list(inputs), rates, at)
     return sp.Matrix([[_sp(-_at(e.diff(_se(w)).subs(ref), at_s)) for w in inputs] for e in Es])
 
 

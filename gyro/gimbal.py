@@ -67,19 +67,22 @@ def integrals(p: dict, q, qd) -> dict:
     """The first integrals (1.2) along states q = (psi, theta, phi), qd (last axis 3):
     H = A3 (phi' + psi' cos theta), L = dT/dpsi', and M = 2 (T - U) - H^2/A3, which is the
     printed A0 psi'^2 + B0 theta'^2 + 2 P1 eta20 sin theta + 2 G cos theta at C0 = 0 and
-    stays an integral for any C0."""
-    q, qd = np.asarray(q, float), np.asarray(qd, float)
-    th, dpsi, dth, dphi = q[..., 1], qd[..., 0], qd[..., 1], qd[..., 2]
-    c = np.cos(th)
-    H = p["A3"] * (dphi + dpsi * c)
-    a_psi = p["A0"] - p["C0"] * c**2
-    G = p["P1"] * p["eta30"] + p["P"] * p["l"]
-    L = a_psi * dpsi + H * c
-    M = a_psi * dpsi**2 + p["B0"] * dth**2 + 2 * p["P1"] * p["eta20"] * np.sin(th) + 2 * G * c
-    return {"H": H, "L": L, "M": M}
+    stays an integral for any C0 (the generated `first_integrals`)."""
+    v = load(MODEL).numpy.first_integrals(param_vector(p), np.asarray(q, float), np.asarray(qd, float))
+    return {"H": v[..., 0], "L": v[..., 1], "M": v[..., 2]}
 
 
-# ------------------------------------------------------------------ Jacobi and Weierstrass
+def _routh(p: dict, theta, H, L) -> np.ndarray:
+    """Routh's U1(theta) (3.3) and its first and second derivatives (the generated
+    `routh_function`), last axis 3."""
+    theta = np.asarray(theta, float)
+    return load(MODEL).numpy.routh_function(param_vector(p), theta[..., None],
+                                            np.broadcast_to([H, L], theta.shape + (2,)))
+
+
+def _gravity_moment(p: dict) -> float:
+    """G = P1 eta30 + P l (1.1), the generated `gravity_moment`."""
+    return float(load(MODEL).numpy.gravity_moment(param_vector(p))[0])
 
 
 def _agm(u, m: float, m1: float):
@@ -243,24 +246,16 @@ class ClosedForm:
     # ---------------------------------------------------------- set-up (mpmath)
 
     def _setup_mp(self):
-        mo, p = self.motion, {k: mp.mpf(v) for k, v in self.motion.params.items()}
-        th0 = mp.mpf(mo.theta0)
-        s0, c0 = mp.sin(th0), mp.cos(th0)
-        A0, B0 = p["A0"], p["B0"]
-        G = p["P1"] * p["eta30"] + p["P"] * p["l"]
-        H = p["A3"] * (mp.mpf(mo.dphi0) + mp.mpf(mo.dpsi0) * c0)
-        a, g, h = A0 * p["P1"] * p["eta20"], A0 * (G - H * mp.mpf(mo.dpsi0)), H**2
-        b0 = A0 * B0 * mp.mpf(mo.dtheta0) ** 2
-        b1 = g * s0 - a * c0
-        b2 = (b0 + 2 * a * s0 + 2 * g * c0 - 2 * h * s0**2) / 3
-        b3 = g * s0 - a * c0 - 2 * h * s0 * c0
-        b4 = b0 + 4 * a * s0 + 4 * g * c0 - 4 * h * c0**2
+        mo = self.motion
+        # b0..b4, g2, g3, H, L at 40 digits from the generated mpmath `closed_form`
+        b, g, HL = load(MODEL).mpmath.closed_form(list(param_vector(mo.params)),
+                                                  [mo.theta0, mo.dtheta0, mo.dpsi0, mo.dphi0])
+        b0, b1, b2, b3, b4 = (b[k] for k in range(5))
         self.b_mp = (b0, b1, b2, b3, b4)
         self.b = tuple(float(x) for x in self.b_mp)
-        self.g2_mp = b0 * b4 - 4 * b1 * b3 + 3 * b2**2
-        self.g3_mp = b0 * b2 * b4 - b1**2 * b4 - b2**3 - b0 * b3**2 + 2 * b1 * b2 * b3
+        self.g2_mp, self.g3_mp = g[0], g[1]
         self.g2, self.g3 = float(self.g2_mp), float(self.g3_mp)
-        self.H, self.L = float(H), float(A0 * mo.dpsi0 + H * c0)
+        self.H, self.L = float(HL[0]), float(HL[1])
         self.time_scale = 2 * math.sqrt(mo.params["A0"] * mo.params["B0"])  # t = time_scale * tau
         # sign of the radical in (2.6): minus when theta increases at t0
         self.sign = -1.0 if mo.dtheta0 > 0 else 1.0
@@ -477,13 +472,13 @@ def mean_drift_paper(motion: Motion, theta_a: float, theta_b: float) -> float:
     that bound the motion: (1/A0) int (L - H cos) / sqrt(f) / int 1 / sqrt(f), f the
     radicand of (2.2) (tanh-sinh quadrature in mpmath, which takes the 1/sqrt ends)."""
     p, I = motion.params, motion.integrals0
+    routh = load(MODEL).mpmath.routh_function
+    P = list(param_vector(p))
     with mp.workdps(30):
         A0, H, L, M = (mp.mpf(x) for x in (p["A0"], I["H"], I["L"], I["M"]))
-        G = mp.mpf(p["P1"]) * p["eta30"] + mp.mpf(p["P"]) * p["l"]
 
-        def f(th):  # A0 B0 theta'^2 from the integrals (1.2)
-            return A0 * (M - (L - H * mp.cos(th)) ** 2 / A0 - 2 * p["P1"] * p["eta20"] * mp.sin(th)
-                         - 2 * G * mp.cos(th))
+        def f(th):  # A0 B0 theta'^2 = A0 (M + 2 U1(theta)) from the integrals (1.2)
+            return A0 * (M + 2 * routh(P, [th], [H, L])[0])
 
         # the roots to 30 digits: an end off by d costs ~sqrt(d) in the integrals
         lo, hi = sorted(mp.findroot(f, mp.mpf(x)) for x in (theta_a, theta_b))
@@ -547,17 +542,13 @@ def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, at
 def stationary_motion(params: dict, theta0: float, H: float) -> Motion:
     """The stationary motion (3.1)-(3.2) at theta0 with rotor momentum H: theta0' = 0,
     (G - H psi0') sin theta0 = P1 eta20 cos theta0, phi0' from H = A3 (phi' + psi' cos)."""
-    G = params["P1"] * params["eta30"] + params["P"] * params["l"]
-    dpsi = (G - params["P1"] * params["eta20"] / math.tan(theta0)) / H
+    dpsi = (_gravity_moment(params) - params["P1"] * params["eta20"] / math.tan(theta0)) / H
     return Motion(params, theta0, 0.0, dpsi, H / params["A3"] - dpsi * math.cos(theta0))
 
 
 def U1_second(params: dict, theta0: float, H: float, L: float) -> float:
     """U1''(theta0) of Routh's function U1 = -P1 eta20 sin - G cos - (L - H cos)^2 / 2 A0 (3.3)."""
-    A0, a = params["A0"], params["P1"] * params["eta20"]
-    G = params["P1"] * params["eta30"] + params["P"] * params["l"]
-    s, c = math.sin(theta0), math.cos(theta0)
-    return a * s + G * c - (H * s) ** 2 / A0 - (L - H * c) * H * c / A0
+    return float(_routh(params, theta0, H, L)[..., 2])
 
 
 def kick(motion: Motion, dtheta: float) -> Motion:
@@ -578,9 +569,13 @@ def turning_points(motion: Motion, n: int = 4096) -> np.ndarray:
     from scipy.optimize import brentq
 
     p, I = motion.params, motion.integrals0
-    G = p["P1"] * p["eta30"] + p["P"] * p["l"]
+    G = _gravity_moment(p)
 
-    def f(th):  # A0 (M - A0 psi'^2 - 2 P1 eta20 sin - 2 G cos) with psi' from L
+    # A0 (M - A0 psi'^2 - 2 P1 eta20 sin - 2 G cos) with psi' from L, which is A0 (M + 2 U1):
+    # kept in this order of operations, because section 6's asymptotic motion starts at the
+    # far turning point of a separatrix and one ulp there decides its motion type
+    # (tests/test_gimbal_section6.py::test_asymptotic_type_property_e; docs/gimbal.md)
+    def f(th):
         dpsi = (I["L"] - I["H"] * np.cos(th)) / p["A0"]
         return p["A0"] * (I["M"] - p["A0"] * dpsi**2 - 2 * p["P1"] * p["eta20"] * np.sin(th) - 2 * G * np.cos(th))
 

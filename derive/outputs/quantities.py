@@ -6,7 +6,6 @@ from __future__ import annotations
 import sympy as sp
 
 from derive.model import TIME, Function, Unsupported
-from derive.outputs.operator import MATRICES
 
 ORDER = 60
 
@@ -28,9 +27,9 @@ def functions(d) -> list[Function]:
                 ins.append((g, groups[g]))
             else:
                 ins.append((g[0], list(g[1])))
-        fns.append(Function(name, ins, [(o, sp.Matrix(m) if not isinstance(m, sp.MatrixBase) else m)
-                                        for o, m in outputs], doc,
-                            MATRICES + tuple(o for o, m in outputs if isinstance(m, sp.MatrixBase) and m.cols > 1)))
+        outs = [(o, sp.Matrix(m)) for o, m in outputs]
+        # a one-column output is a vector; wider ones are matrices
+        fns.append(Function(name, ins, outs, doc, tuple(o for o, m in outs if m.cols > 1)))
     return fns
 
 

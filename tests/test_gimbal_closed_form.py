@@ -185,7 +185,9 @@ def test_the_other_sign_in_2_6_is_far_off():
     assert np.max(np.abs(cf.theta(t) - q[:, 1])) > 1e-3
 
 
-@settings(max_examples=6, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
+# 25 draws (~0.5 s each, ~12 s): random from hypothesis, derandomized so that CI runs the
+# same sets each time (docs/gimbal.md says so); draws rejected by assume() do not count.
+@settings(max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 @given(A0=st.floats(0.005, 0.05), B0=st.floats(0.005, 0.05), A3=st.floats(0.002, 0.02),
        P1=st.floats(0.0, 20.0), eta20=st.floats(-0.01, 0.01), eta30=st.floats(-0.02, 0.02),
        P=st.floats(0.0, 20.0), l=st.floats(-0.03, 0.03), theta0=st.floats(-3.0, 3.0),

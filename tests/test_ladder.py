@@ -129,12 +129,22 @@ FORMULA_CASES = {
 }
 
 
-@pytest.mark.parametrize("case", list(FORMULA_CASES))
+# The calibrated constants (omega1, (3.26), (3.28); docs/methods.md) were set on random
+# sets varying spin, K0, Kp, K_gamma and latitude, and on the spin / 1000 edge: of the cases
+# above, "example", "spin /10", "spin x10", "Kgamma /10" and "phi 0" lie in those
+# directions. The held-out cases move only parameters the calibration never varied (the
+# masses, lengths, inertias and g), each by 1/2 and 2, chosen before looking at the result.
+# Measured worst ratio of error to estimate over them: 0.77 (l x2).
+HELD_OUT = {f"{k} x{fct:g}": {k: MODEL.defaults[k] * fct}
+            for k in ("m", "M", "I1", "I2", "I3", "A", "C", "l", "l1", "l2", "g") for fct in (0.5, 2.0)}
+
+
+@pytest.mark.parametrize("case", list(FORMULA_CASES) + [f"held out: {k}" for k in HELD_OUT])
 def test_formula_estimates_bound_their_errors(case):
     """Each mode's formula against the nearest exact root: the error stays below the
     formula's own estimate (its small parameter to its order), and every formula that errs
     by more than 1 % is flagged (estimate above 1 %)."""
-    over = FORMULA_CASES[case]
+    over = HELD_OUT[case[10:]] if case.startswith("held out: ") else FORMULA_CASES[case]
     f = ladder.spectrum(MODEL, params(**over), "formulas")
     d = ladder.spectrum(MODEL, params(**over), "default")
     err = np.min(np.abs(f.frequencies[0][:, None] / d.frequencies[0][None, :] - 1), axis=1)
@@ -171,17 +181,29 @@ def test_estimate_of_3_4_is_the_next_term_of_its_series(over):
 def test_nutation_estimate_is_exceeded_far_from_the_example():
     """A limit of a calibrated estimate, pinned (docs/methods.md): with a long torsion bar
     and a heavy casing about x3 (l = 0.75 m, I3 x5: a = 13.5) the nutation root near 160 1/s
-    errs by 10 %, three times its estimate mu1 + kappa6 (the gravity shift outgrows
-    kappa6). The estimate still says more than 1 %, so the formula is flagged; on the wide
-    sweep (bench/formula_sweep.py) some sets are not. When a derived gravity term replaces
-    kappa6, this test must change with docs/methods.md."""
-    f = ladder.spectrum(MODEL, params(l=0.75, I3=0.0015), "formulas")
-    d = ladder.spectrum(MODEL, params(l=0.75, I3=0.0015), "default")
+    errs by 10.4 %, 3.0 times its estimate mu1 + kappa6 = 3.5 %. What matters, asserted:
+    - the estimate is exceeded (this pins the known limit: when the estimate is replaced,
+      this test must change with docs/methods.md);
+    - by at most 15.5x, the worst ratio the wide sweep records for the nutation roots
+      (bench/results/formula_sweep.json, docs/methods.md): this set is no new extreme;
+    - the estimate still says more than 1 %, so the formula is flagged (on the wide sweep
+      some sets are not).
+    The error is not the gravity shift: between g = u = 0 and the example's g, u the exact
+    root moves by 6.3e-5 (asserted below 1e-3), so the 10 % is the distance of the formula
+    to the g = 0 root itself."""
+    over = {"l": 0.75, "I3": 0.0015}
+    f = ladder.spectrum(MODEL, params(**over), "formulas")
+    d = ladder.spectrum(MODEL, params(**over), "default")
     err = np.min(np.abs(f.frequencies[0][:, None] / d.frequencies[0][None, :] - 1), axis=1)
     j = int(np.argmax(err / f.error_estimate[0]))
+    est = f.error_estimate[0][j]
     assert abs(f.frequencies[0][j] - 160) < 1 and err[j] > 0.09
-    assert 2.5 < err[j] / f.error_estimate[0][j] < 3.5
-    assert f.error_estimate[0][j] > 0.01
+    assert est < err[j] <= 15.5 * est
+    assert est > 0.01
+    d0 = ladder.spectrum(MODEL, params(**over, g=0.0, u=0.0), "default")
+    w = d.frequencies[0][np.argmin(np.abs(d.frequencies[0] - f.frequencies[0][j]))]
+    w0 = d0.frequencies[0][np.argmin(np.abs(d0.frequencies[0] - w))]
+    assert abs(w / w0 - 1) < 1e-3
 
 
 def test_estimate_of_3_9_holds_where_delta6_squared_does_not():
@@ -256,11 +278,9 @@ def test_top_heavy_degree_of_instability_and_gyroscopic_slowing():
 
 
 # random parameter sets within the physical ranges of the charts
-SPREAD = st.fixed_dictionaries({
-    "H": st.floats(0.1, 10.0), "K0": st.floats(0.1, 10.0), "Kp": st.floats(0.1, 10.0),
-    "Kgamma": st.floats(0.1, 10.0), "phi": st.floats(0.0, 89.0), "m": st.floats(0.5, 2.0),
-    "M": st.floats(0.5, 2.0), "I1": st.floats(0.5, 2.0), "A": st.floats(0.5, 2.0),
-})
+SPREAD_RANGES = {"H": (0.1, 10.0), "K0": (0.1, 10.0), "Kp": (0.1, 10.0), "Kgamma": (0.1, 10.0),
+                 "phi": (0.0, 89.0), "m": (0.5, 2.0), "M": (0.5, 2.0), "I1": (0.5, 2.0), "A": (0.5, 2.0)}
+SPREAD = st.fixed_dictionaries({k: st.floats(lo, hi) for k, (lo, hi) in SPREAD_RANGES.items()})
 
 
 @settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -272,6 +292,38 @@ def test_default_meets_its_bound_on_random_sets(draw):
     r = ladder.spectrum(MODEL, p, "reference")
     err = rel_err(s, r)
     assert np.all(err <= s.error_estimate[0]) and np.all(err <= TOL), (over, err)
+
+
+# Budget: the mpmath reference costs ~0.8 s a set, so the hypothesis test above draws 12
+# sets (~10 s). The seeded sweep below takes 400 sets from the same ranges and checks the
+# default against the general rung run set by set (companion eigenvalues, each refined by
+# Newton on the exact operator, with its own rounding estimate): ~3.5 ms a set, ~1.5 s in
+# all. The general rung is a different algorithm from the default's block route (the
+# default escalates to it only on hard sets), so an error in either shows.
+SWEEP_SETS = 400
+
+
+def test_default_agrees_with_the_refined_companion_on_a_seeded_sweep():
+    rng = np.random.default_rng(20261130)
+    names = list(SPREAD_RANGES)
+    lo, hi = np.array([SPREAD_RANGES[k] for k in names]).T
+    draws = lo + (hi - lo) * rng.random((SWEEP_SETS, len(names)))
+    P = np.array([params(**{k: (v if k == "phi" else MODEL.defaults[k] * v) for k, v in zip(names, d)})
+                  for d in draws])
+    s = ladder.spectrum(MODEL, P, "default")
+    worst = 0.0
+    for i in range(SWEEP_SETS):
+        qe, _ = ladder.equilibria(MODEL, P[i:i + 1])
+        M, D, K = ladder.operators(MODEL, P[i:i + 1], qe)
+        g_roots, g_est = ladder._general(M[0], D[0], K[0])
+        up = g_roots.imag >= 0
+        g_roots, g_est = g_roots[up], g_est[up]
+        for lam_d, est_d in zip(lam(s)[i], s.error_estimate[i]):
+            j = int(np.argmin(np.abs(g_roots - lam_d)))
+            d = abs(g_roots[j] - lam_d) / abs(g_roots[j])
+            assert d <= est_d + g_est[j] and d <= TOL + g_est[j], (draws[i], lam_d, g_roots[j], est_d, g_est[j])
+            worst = max(worst, d)
+    assert worst <= TOL
 
 
 def test_batch_equals_single_sets():

@@ -7,7 +7,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 
-.PHONY: setup derive test check-generated pytest bench clean
+.PHONY: setup derive test test-unit check-generated pytest bench clean
 
 setup: $(STAMP)
 
@@ -34,6 +34,9 @@ pytest: $(STAMP)
 	$(PY) -m pytest -q
 
 test: check-generated pytest
+
+test-unit: $(STAMP)
+	$(PY) -m pytest -q -m unit
 
 bench: $(STAMP)
 	$(PY) -m bench

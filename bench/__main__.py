@@ -60,7 +60,7 @@ def bench_derive(timeout: float, skip_baseline: bool) -> dict:
     if finished:
         # the baseline linearises at the approximate equilibrium (2.2): compare there
         from gyro import load
-        from gyro.modal import _companion_eigenvalues, refine_all, representatives
+        from gyro.qep import companion_eigenvalues as _companion_eigenvalues, refine_all, representatives
 
         m = load("torsion_gyrocompass")
         P = m.vector(m.defaults)

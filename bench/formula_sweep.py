@@ -16,7 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from gyro import campbell, ladder, load
+from gyro import ladder, load
+from gyro.kernels import function
+from gyro.results import nearest_error
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"
@@ -40,11 +42,11 @@ def main() -> int:
     f = ladder.spectrum(MODEL, P, "formulas")
     exact = ladder.spectrum(MODEL, P, "default")
     usable = (exact.route == "structured") & np.all(exact.growth == 0, axis=1)  # stable, answered
-    err = campbell.nearest_error(f.frequencies, exact.frequencies)
+    err = nearest_error(f.frequencies, exact.frequencies)
     with np.errstate(all="ignore"):
         ratio = err / f.error_estimate
     # which mode's formula each returned frequency is: the nearest candidate value
-    omega, _ = ladder._fn(MODEL, "mode_formulas")(P)
+    omega, _ = function(MODEL, "mode_formulas")(P)
     modes = [x["mode"] for x in MODEL.meta["mode_formulas"]]
     out = {"sets": SETS, "seed": SEED, "spread": SPREAD, "varied": list(VARIED), "usable_sets": int(usable.sum()),
            "per_mode": {m: {"exceeded": 0, "worst_ratio": 0.0, "unflagged_over_1_percent": 0} for m in modes}}

@@ -22,7 +22,10 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from gyro import campbell, cbackend, ladder, load  # noqa: E402
+from gyro import cbackend, ladder, load  # noqa: E402
+from gyro.analyses import campbell  # noqa: E402
+from gyro.analyses.stability_map import stability_grid  # noqa: E402
+from gyro.results import nearest_error  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"
@@ -96,7 +99,7 @@ def main() -> int:
             else:
                 s = ladder.spectrum(MODEL, P, m)
             if s.method == "formulas":  # approximate modes: distance to the nearest exact root
-                err = campbell.nearest_error(s.frequencies, r.frequencies)
+                err = nearest_error(s.frequencies, r.frequencies)
             elif m == "reference":
                 err = s.error_estimate
             else:
@@ -119,15 +122,15 @@ def main() -> int:
     chart(out)
     print("Campbell diagram and stability map ...", flush=True)
     data = campbell.sweep(MODEL, MODEL.defaults, 0.1, 10.0, 240)
-    campbell.plot(MODEL, data, RESULTS / "campbell.png")
+    data.plot(RESULTS / "campbell.png")
     # the rotor centre's height against the angular momentum: the boundary m l2 + M l1 = 0
     # (l_c = 0) from the derivation, and how H slows the growth it can reach (H^-1/2)
     d = MODEL.defaults
-    grid = campbell.stability_grid(MODEL, d, "l2", (-0.5, 0.3), "H", (0.01, 10.0), 70, ylog=True)
+    grid = stability_grid(MODEL, d, "l2", (-0.5, 0.3), "H", (0.01, 10.0), 70, ylog=True)
     lc0 = -d["M"] * d["l1"] / d["m"]
-    campbell.plot_stability(MODEL, grid, RESULTS / "stability_map.png",
-                            lines=[([lc0, lc0], [0.01, 10.0], "l_c = 0 (m l2 + M l1 = 0)")])
-    out["campbell_shaded_fraction"] = data["shaded_fraction"]
+    grid.plot(RESULTS / "stability_map.png",
+              lines=[([lc0, lc0], [0.01, 10.0], "l_c = 0 (m l2 + M l1 = 0)")])
+    out["campbell_shaded_fraction"] = data.shaded_fraction
     path = RESULTS / "ladder.json"
     path.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
     st = out["standing"]

@@ -13,6 +13,28 @@ GENERATED = ROOT / "generated"
 MODEL = "torsion_gyrocompass"
 
 
+# Tiers (docs/architecture.md): each test file belongs to one, marked by its name, so that
+# `pytest -m unit` (make test-unit) runs the fast tier alone; `make test` runs them all.
+TIERS = {
+    "unit": ("test_mechanics", "test_machinery", "test_architecture"),
+    "generated": ("test_generated", "test_textbook", "test_docs_models", "test_derivation"),
+    "paper": ("test_paper", "test_anchors", "test_nonlinear", "test_gimbal", "test_gimbal_closed_form",
+              "test_gimbal_section6", "test_gimbal_paper_items"),
+    "methods": ("test_ladder",),
+    "properties": ("test_properties",),
+    "cli": ("test_cli", "test_gimbal_simulate"),
+}
+_TIER_OF = {f: tier for tier, files in TIERS.items() for f in files}
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        stem = Path(str(item.fspath)).stem
+        if stem not in _TIER_OF:
+            raise pytest.UsageError(f"{stem}.py belongs to no tier: add it to TIERS in tests/conftest.py")
+        item.add_marker(getattr(pytest.mark, _TIER_OF[stem]))
+
+
 @pytest.fixture(scope="session")
 def tg_model():
     return derived(MODEL)[0]

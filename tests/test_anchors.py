@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from gyro import ladder
-from gyro.modal import natural_frequencies
+from gyro.ladder import natural_frequencies
 from tests.test_paper import MODEL, exact, formulas, rel
 FIXTURE = Path(__file__).resolve().parent / "fixtures" / "anchor_frequencies.json"
 DATA = json.loads(FIXTURE.read_text())
@@ -76,7 +76,7 @@ def test_fixture_is_the_paper_example_and_moves_every_parameter():
 
 @pytest.mark.parametrize("name", list(SETS))
 def test_exact_frequencies_match_the_independent_baseline(name):
-    """All ten frequencies of the exact operator (gyro.modal.natural_frequencies, the
+    """All ten frequencies of the exact operator (gyro.ladder.natural_frequencies, the
     ladder's default rung) equal the baseline's to 1e-9 relative."""
     s = SETS[name]
     w = np.array(natural_frequencies(MODEL, MODEL.parameters(s["params"])).frequencies)

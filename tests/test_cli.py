@@ -111,7 +111,8 @@ def test_an_instability_is_reported_not_hidden():
 
 def test_modal_result_saves_and_loads_itself(tmp_path):
     from gyro import load
-    from gyro.modal import ModalResult, natural_frequencies
+    from gyro.ladder import natural_frequencies
+    from gyro.results import ModalResult
 
     m = load("torsion_gyrocompass")
     r = natural_frequencies(m, m.parameters({"phi": 45.0}))

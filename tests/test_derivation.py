@@ -83,7 +83,7 @@ def test_equilibrium_against_2_2(over):
     (the bearings' sag x3 ~ m g/Kp and tilt gamma2 shift the rotor's lever) and H u/G;
     x3 = -m g/Kp is exact up to O(beta^2, u^2 l/g) ~ 1e-10."""
     from gyro import load
-    from gyro.modal import equilibrium
+    from gyro.equilibrium import equilibrium
 
     m = load("torsion_gyrocompass")
     v = m.parameters(over)
@@ -211,7 +211,7 @@ def test_runtime_equilibrium_matches_a_40_digit_solution(tg_derivation, tg_model
     """The runtime's Newton iteration (double precision, generated code) against mpmath's
     findroot on the un-CSE'd symbolic equilibrium equations, 40 digits."""
     from gyro import load
-    from gyro.modal import equilibrium
+    from gyro.equilibrium import equilibrium
 
     m = load("torsion_gyrocompass")
     values = m.parameters(over)

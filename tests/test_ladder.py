@@ -13,7 +13,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from gyro import ladder, load
+from gyro import ladder, load, qep
+from gyro.equilibrium import equilibria, operators
+from gyro.methods import default, reference
 
 MODEL = load("torsion_gyrocompass")
 TOL = ladder.DEFAULT_TOL
@@ -67,8 +69,8 @@ def test_default_within_its_estimate_and_1e_10(case):
 def test_reference_is_self_consistent_across_precisions():
     """40 digits against 60: the reference's estimate bounds its change."""
     p = params()
-    r40 = ladder.reference(MODEL, p[None], dps=40)
-    r60 = ladder.reference(MODEL, p[None], dps=60)
+    r40 = reference.solve(MODEL, p[None], dps=40)
+    r60 = reference.solve(MODEL, p[None], dps=60)
     d = np.abs(lam(r40)[0] - lam(r60)[0]) / np.abs(lam(r60)[0])
     assert np.all(d <= r40.error_estimate[0] + 1e-30)
 
@@ -313,9 +315,9 @@ def test_default_agrees_with_the_refined_companion_on_a_seeded_sweep():
     s = ladder.spectrum(MODEL, P, "default")
     worst = 0.0
     for i in range(SWEEP_SETS):
-        qe, _ = ladder.equilibria(MODEL, P[i:i + 1])
-        M, D, K = ladder.operators(MODEL, P[i:i + 1], qe)
-        g_roots, g_est = ladder._general(M[0], D[0], K[0])
+        qe, _ = equilibria(MODEL, P[i:i + 1])
+        M, D, K = operators(MODEL, P[i:i + 1], qe)
+        g_roots, g_est = qep.general(M[0], D[0], K[0])
         up = g_roots.imag >= 0
         g_roots, g_est = g_roots[up], g_est[up]
         for lam_d, est_d in zip(lam(s)[i], s.error_estimate[i]):
@@ -390,8 +392,8 @@ def test_compiled_kernels_refuse_wrong_shapes():
     from gyro import cbackend
 
     P = params()[None]
-    qe, _ = ladder.equilibria(MODEL, P)
-    M, D, K = ladder.operators(MODEL, P, qe)
+    qe, _ = equilibria(MODEL, P)
+    M, D, K = operators(MODEL, P, qe)
     herm = cbackend.qep_hermitian(MODEL.name)
     for idx in ([0, 10], [1, 1], list(range(11)), []):
         with pytest.raises(ValueError, match="block indices"):
@@ -406,11 +408,11 @@ def test_large_batches_run_in_pieces_with_the_same_answers():
     """Beyond DEFAULT_CHUNK sets the default runs piece by piece (bounded memory): the
     answers and routes are those of the sets alone."""
     P = np.array([params(), params(phi=89.99), params(l1=-0.05, l2=-0.05)])
-    big = np.tile(P, (ladder.DEFAULT_CHUNK // 3 + 2, 1))
+    big = np.tile(P, (default.CHUNK // 3 + 2, 1))
     s = ladder.spectrum(MODEL, big, "default")
     alone = ladder.spectrum(MODEL, P, "default")
     assert s.frequencies.shape == (len(big), 10) and s.equilibrium.shape[0] == len(big)
-    for k in (0, ladder.DEFAULT_CHUNK - 1, ladder.DEFAULT_CHUNK, len(big) - 1):
+    for k in (0, default.CHUNK - 1, default.CHUNK, len(big) - 1):
         np.testing.assert_array_equal(s.frequencies[k], alone.frequencies[k % 3])
         assert s.route[k] == alone.route[k % 3]
 
@@ -418,12 +420,12 @@ def test_large_batches_run_in_pieces_with_the_same_answers():
 def test_no_equilibrium_in_any_precision_is_said():
     """Inputs beyond double precision (Kp = 1e300): no rung answers; the route says 'none',
     the frequencies are NaN, and the one-set API raises instead of returning them."""
-    from gyro import modal
+    from gyro.equilibrium import EquilibriumError
 
     s = ladder.spectrum(MODEL, params(Kp=1e300), "default")
     assert s.route[0] == "none" and np.all(np.isnan(s.frequencies))
-    with pytest.raises(modal.EquilibriumError):
-        modal.natural_frequencies(MODEL, MODEL.parameters({"Kp": 1e300}))
+    with pytest.raises(EquilibriumError):
+        ladder.natural_frequencies(MODEL, MODEL.parameters({"Kp": 1e300}))
 
 
 def test_refinement_steps_agree_root_by_root():
@@ -432,15 +434,15 @@ def test_refinement_steps_agree_root_by_root():
     from gyro.cbackend import qep_refine
 
     P = np.array([params(), params(phi=60.0), params(H=0.1)])
-    qe, _ = ladder.equilibria(MODEL, P)
-    M, D, K = ladder.operators(MODEL, P, qe)
+    qe, _ = equilibria(MODEL, P)
+    M, D, K = operators(MODEL, P, qe)
     n = M.shape[-1]
     rng = np.random.default_rng(1)
     w0 = np.sort(np.abs(ladder.spectrum(MODEL, P, "companion").frequencies), axis=1)
     w0 = w0 * (1 + 1e-4 * rng.standard_normal(w0.shape))
-    z0 = ladder._start_vectors(len(P), n, n)
+    z0 = qep.start_vectors(len(P), n, n)
     wc, zc, ec, okc = qep_refine(MODEL.name)(M, D, K, w0, z0, 1, 0.0)
-    wn, zn, en, okn = ladder._rayleigh_step(M, D, K, w0, np.array(z0))
+    wn, zn, en, okn = qep.rayleigh_step(M, D, K, w0, np.array(z0))
     assert okc.all() and okn.all()
     np.testing.assert_allclose(wc, wn, rtol=1e-12)
     np.testing.assert_allclose(np.abs(np.sum(zc.conj() * zn, axis=-1)), 1.0, rtol=1e-10)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from gyro import load
-from gyro.modal import equilibrium
+from gyro.equilibrium import equilibrium
 
 MODEL = load("torsion_gyrocompass")
 
@@ -82,7 +82,7 @@ def test_nonlinear_small_oscillation_has_the_linear_frequency(mode):
     from scipy.integrate import solve_ivp
     from scipy.optimize import brentq
 
-    from gyro.modal import natural_frequencies
+    from gyro.ladder import natural_frequencies
 
     values = MODEL.parameters()
     P = MODEL.vector(values)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from gyro import load
-from gyro.modal import natural_frequencies
+from gyro.ladder import natural_frequencies
 
 MODEL = load("torsion_gyrocompass")
 NAMES = [f["name"] for f in MODEL.meta["formulas"]]
@@ -358,7 +358,7 @@ def test_sag_identity_at_u_0():
     """At u = 0 the exact operator about the exact equilibrium equals the paper's variant
     with l2 -> l2 + m g/K_p (the rotor's radial sag): the reason the '_eq' formulas match
     the exact operator to O(eps2^2) while the q = 0 formulas miss it at O(eps2)."""
-    from gyro.modal import equilibrium
+    from gyro.equilibrium import equilibrium
 
     v = MODEL.parameters({"u": 0.0})
     P = MODEL.vector(v)

@@ -9,7 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gyro import load
-from gyro.modal import equilibrium, natural_frequencies
+from gyro.equilibrium import equilibrium
+from gyro.ladder import natural_frequencies
 
 MODEL = load("torsion_gyrocompass")
 

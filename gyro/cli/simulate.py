@@ -10,49 +10,55 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import sys
 from pathlib import Path
 
 import numpy as np
 
+from gyro.cli.common import add_json, add_set, parse_sets
 from gyro.models import Param, ParameterError, load
 
+ORDER = 50
 SIMULATED = ("gimbal_gyroscope",)
-RTOL, ATOL = 1e-10, 1e-12  # the integrators' tolerances from the command line
 
 
-def add_parser(sub) -> None:
-    """Register `simulate` on the `gyro` subparsers."""
+def register(sub) -> None:
     s = sub.add_parser("simulate", help="a motion of the gimbal gyroscope: closed form or integrator")
     s.add_argument("model")
-    s.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                   help="parameter or initial condition (theta0 dtheta0 dpsi0 dphi0), SI units, radians")
+    add_set(s, "parameter or initial condition (theta0 dtheta0 dpsi0 dphi0), SI units, radians")
     s.add_argument("--t-end", required=True, metavar="T", help="end time in s (> 0)")
     s.add_argument("--points", default="1001", metavar="N", help="number of time points from 0 to T (>= 2)")
     s.add_argument("--method", default="closed_form", metavar="NAME",
                    help="closed_form (default), RK45, DOP853, Radau, BDF, LSODA, cvodes or idas")
-    s.add_argument("--json", action="store_true", help="print one JSON object")
+    add_json(s)
     s.add_argument("--out", metavar="FILE.png", help="also plot theta, psi, phi against t into FILE.png")
     s.set_defaults(run=run)
 
 
 def _initial_params() -> list[Param]:
-    from gyro.gimbal import INITIAL
+    from gyro.analyses.gimbal import INITIAL
 
     return [Param(n, u, d, desc, "real", (None, None)) for n, (u, d, desc) in INITIAL.items()]
 
 
+def _number(name: str, raw: str) -> float:
+    try:
+        value = float(raw)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name}: not a number: {raw!r}") from None
+    if not math.isfinite(value):
+        raise ParameterError(f"{name}: must be a finite number, got {raw!r}")
+    return value
+
+
 def parse(args):
     """(Motion, times, method) from the arguments, or ParameterError naming the input."""
-    from gyro.cli import _parse_sets
-    from gyro.gimbal import METHODS, Motion
+    from gyro.analyses.gimbal import METHODS, Motion
 
     if args.model not in SIMULATED:
         raise ParameterError(f"simulate: unknown model {args.model!r}; it covers {', '.join(SIMULATED)}")
     model = load(args.model)
     ic = {p.name: p for p in _initial_params()}
-    sets = _parse_sets(args.set)
+    sets = parse_sets(args.set)
     known = [*model.param_names, *ic]
     for key in sets:
         if key not in known:
@@ -87,79 +93,17 @@ def parse(args):
     return motion, np.linspace(0.0, t_end, points), args.method
 
 
-def _number(name: str, raw: str) -> float:
-    try:
-        value = float(raw)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name}: not a number: {raw!r}") from None
-    if not math.isfinite(value):
-        raise ParameterError(f"{name}: must be a finite number, got {raw!r}")
-    return value
-
-
-def motion_path(motion, t: np.ndarray, method: str):
-    """theta, psi, phi at the times t by the closed form or an integrator."""
-    from gyro.gimbal import ClosedForm, integrate
-
-    if method == "closed_form":
-        cf = ClosedForm(motion)
-        psi, phi = cf.psi_phi(t)
-        return cf.theta(t), psi, phi, cf
-    q, _ = integrate(motion, t, method, RTOL, ATOL)
-    return q[:, 1], q[:, 0], q[:, 2], None
-
-
 def run(args) -> int:
+    from gyro.analyses.gimbal import trajectory
+
     motion, t, method = parse(args)
-    theta, psi, phi, cf = motion_path(motion, t, method)
-    if not (np.all(np.isfinite(theta)) and np.all(np.isfinite(psi)) and np.all(np.isfinite(phi))):
+    tr = trajectory(motion, t, method)
+    if not (np.all(np.isfinite(tr.theta)) and np.all(np.isfinite(tr.psi)) and np.all(np.isfinite(tr.phi))):
         raise FloatingPointError("a coordinate is not finite")
-    I = motion.integrals0
     if args.out is not None:
-        _plot(Path(args.out), t, theta, psi, phi, method)
+        tr.plot(Path(args.out))
     if args.json:
-        print(json.dumps({"t": t.tolist(), "theta": theta.tolist(), "psi": psi.tolist(),
-                          "phi": phi.tolist(), "method": method, "integrals": I}, allow_nan=False))
-        return 0
-    model = load(args.model)
-    print(f"{model.meta['title']} ({model.name}), method {method}")
-    print(f"integrals at t = 0: H = {I['H']:.9g}, L = {I['L']:.9g}, M = {I['M']:.9g}")
-    if cf is not None:
-        period = "none (stationary or on the separatrix)" if not math.isfinite(cf.period) else f"{cf.period:.9g} s"
-        print(f"motion: {cf.motion_type}; period of theta {period}")
-    rows = range(len(t)) if len(t) <= 21 else np.unique(np.linspace(0, len(t) - 1, 11).round().astype(int))
-    print(f"{'t [s]':>14} {'theta [rad]':>18} {'psi [rad]':>18} {'phi [rad]':>18}")
-    for i in rows:
-        print(f"{t[i]:>14.6g} {theta[i]:>18.12g} {psi[i]:>18.12g} {phi[i]:>18.12g}")
-    if len(t) > 21:
-        print(f"({len(t)} points; 11 shown; --json prints all)")
+        print(json.dumps(tr.to_dict(), allow_nan=False))
+    else:
+        print(tr.table())
     return 0
-
-
-def _plot(path: Path, t, theta, psi, phi, method: str) -> None:
-    """theta, psi, phi against t into path, written whole or not at all."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(7, 6))
-    for ax, y, name in zip(axes, (theta, psi, phi), ("theta", "psi", "phi")):
-        ax.plot(t, y, lw=1)
-        ax.set_ylabel(f"{name} [rad]")
-    axes[0].set_title(f"gimbal gyroscope, {method}")
-    axes[-1].set_xlabel("t [s]")
-    fig.tight_layout()
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp.png")
-    try:
-        fig.savefig(tmp, dpi=100)
-        tmp.replace(path)
-    finally:
-        plt.close(fig)
-        tmp.unlink(missing_ok=True)
-
-
-if __name__ == "__main__":
-    from gyro.cli import main
-
-    sys.exit(main(["simulate", *sys.argv[1:]]))

@@ -583,3 +583,28 @@ def turning_points(motion: Motion, n: int = 4096) -> np.ndarray:
     v = f(th)
     idx = np.nonzero(np.sign(v[:-1]) * np.sign(v[1:]) < 0)[0]
     return np.array([brentq(f, th[i], th[i + 1], xtol=1e-15) for i in idx])
+
+
+# ------------------------------------------------------------------ a motion as a result
+
+
+RTOL, ATOL = 1e-10, 1e-12  # the integrators' tolerances of `trajectory`
+
+
+def trajectory(motion: Motion, t, method: str = "closed_form"):
+    """theta, psi, phi at the times t by the closed form or an integrator, as a
+    gyro.results.Trajectory (with the motion type and the period from the closed form)."""
+    from gyro.results import Trajectory
+
+    t = np.asarray(t, dtype=float)
+    model = load(MODEL)
+    kind = period = None
+    if method == "closed_form":
+        cf = ClosedForm(motion)
+        psi, phi = cf.psi_phi(t)
+        theta, kind, period = cf.theta(t), cf.motion_type, cf.period
+    else:
+        q, _ = integrate(motion, t, method, RTOL, ATOL)
+        theta, psi, phi = q[:, 1], q[:, 0], q[:, 2]
+    return Trajectory(MODEL, model.meta["title"], method, t, theta, psi, phi,
+                      motion.integrals0, kind, period)

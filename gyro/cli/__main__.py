@@ -1,0 +1,5 @@
+import sys
+
+from gyro.cli import main
+
+sys.exit(main())

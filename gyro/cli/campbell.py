@@ -1,0 +1,36 @@
+"""`gyro campbell MODEL [--set NAME=VALUE]... --out FILE.png [--range LO HI] [--points N]`"""
+from __future__ import annotations
+
+from gyro.cli.common import add_out, add_points, add_quiet, add_set, check_png_out, model_with_equilibrium, parse_sets
+from gyro.models import ParameterError
+
+ORDER = 20
+
+
+def register(sub) -> None:
+    c = sub.add_parser("campbell", help="Campbell diagram: frequencies against spin, formulas overlaid")
+    c.add_argument("model")
+    add_set(c)
+    add_out(c)
+    c.add_argument("--range", nargs=2, type=float, default=(0.1, 10.0), metavar=("LO", "HI"),
+                   help="spin range as multiples of the set's H (default: 0.1 10)")
+    add_points(c, 200, "spins in the sweep (default: 200)")
+    add_quiet(c)
+    c.set_defaults(run=run)
+
+
+def run(args) -> int:
+    from gyro.analyses.campbell import sweep
+
+    model = model_with_equilibrium(args.model)
+    values = model.parameters(parse_sets(args.set))
+    lo, hi = args.range
+    if not (0 < lo < hi):
+        raise ParameterError(f"--range: need 0 < LO < HI, got {lo} {hi}")
+    if args.points < 2:
+        raise ParameterError(f"--points: need at least 2, got {args.points}")
+    out = check_png_out(args.out)
+    diagram = sweep(model, values, lo, hi, args.points, progress=not args.quiet)
+    diagram.plot(out)
+    print(diagram.summary(out))
+    return 0

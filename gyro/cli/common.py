@@ -1,0 +1,74 @@
+"""What the commands share: the one-line usage errors (exit 2), the argument helpers for
+`--set`, `--out`, `--json` and `--points`, and the checks of a model and an output file."""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from gyro.models import ParameterError, load
+
+EXIT_USAGE = 2
+SET_HELP = "parameter value in SI units (phi in degrees); repeat as needed"
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse that reports a usage error in one line and exits with 2."""
+
+    def error(self, message):
+        print(f"{self.prog}: error: {message}", file=sys.stderr)
+        sys.exit(EXIT_USAGE)
+
+
+def add_set(p, help: str | None = SET_HELP) -> None:
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE", help=help)
+
+
+def add_json(p) -> None:
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def add_out(p, required: bool = True, help: str | None = "image to write") -> None:
+    p.add_argument("--out", required=required, metavar="FILE.png", help=help)
+
+
+def add_points(p, default, help: str | None = None, type=int) -> None:
+    p.add_argument("--points", type=type, default=default, help=help)
+
+
+def add_quiet(p) -> None:
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def parse_sets(items: list[str]) -> dict[str, str]:
+    """NAME=VALUE items into a dict (values still text: the model checks them)."""
+    out = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip():
+            raise ParameterError(f"--set {item!r}: expected NAME=VALUE")
+        out[name.strip()] = value.strip()
+    return out
+
+
+def model_with_equilibrium(name):
+    model = load(name)
+    if model.meta.get("momenta"):
+        raise ParameterError(f"{model.name}: its operator depends on the momenta "
+                             f"{', '.join(model.meta['momenta'])} of a stationary motion; "
+                             "this command covers models with a relative equilibrium")
+    return model
+
+
+def check_png_out(path) -> Path:
+    """A figure's --out: a .png in a folder that exists and is writable."""
+    out = Path(path)
+    if out.suffix.lower() != ".png":
+        raise ParameterError(f"--out {path!r}: the figure is written as PNG; name it *.png")
+    parent = out.resolve().parent
+    if not parent.is_dir():
+        raise ParameterError(f"--out {path!r}: folder {parent} does not exist")
+    if not os.access(parent, os.W_OK):
+        raise ParameterError(f"--out {path!r}: folder {parent} is not writable")
+    return out

@@ -1,0 +1,37 @@
+"""`gyro frequencies MODEL [--set NAME=VALUE]... [--method NAME] [--json]`"""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from gyro import ladder
+from gyro.cli.common import add_json, add_set, model_with_equilibrium, parse_sets
+from gyro.models import ParameterError
+
+ORDER = 10
+
+
+def register(sub) -> None:
+    f = sub.add_parser("frequencies", help="natural frequencies of a model's exact linear operator")
+    f.add_argument("model")
+    add_set(f)
+    add_json(f)
+    f.add_argument("--method", default="default", choices=ladder.METHODS,
+                   help="rung of the ladder (default: %(default)s; docs/methods.md)")
+    f.set_defaults(run=run)
+
+
+def run(args) -> int:
+    model = model_with_equilibrium(args.model)
+    values = model.parameters(parse_sets(args.set))
+    if args.method == "formulas" and "mode_formulas" not in model.meta["functions"]:
+        raise ParameterError(f"--method formulas: {model.name} has no approximate formulas")
+    spec = ladder.spectrum(model, model.vector(values), args.method)
+    if not np.all(np.isfinite(spec.frequencies[0])):
+        raise FloatingPointError("a frequency is not finite")
+    if args.json:
+        print(json.dumps(spec.to_dict(0, model, values), allow_nan=False))
+    else:
+        print(spec.table(0, model))
+    return 0

@@ -1,0 +1,20 @@
+"""`gyro params MODEL`"""
+from __future__ import annotations
+
+from gyro.models import load
+
+ORDER = 40
+
+
+def register(sub) -> None:
+    p = sub.add_parser("params", help="list a model's parameters with the paper example's values")
+    p.add_argument("model")
+    p.set_defaults(run=run)
+
+
+def run(args) -> int:
+    model = load(args.model)
+    print(f"{'name':<8} {'default':>14} {'unit':<10} description")
+    for p in model.params:
+        print(f"{p.name:<8} {p.default:>14.8g} {p.unit:<10} {p.description}")
+    return 0

@@ -1,0 +1,49 @@
+"""`gyro stability-map MODEL --x NAME --x-range LO HI --y NAME --y-range LO HI [--x-log]
+[--y-log] --out FILE.png`"""
+from __future__ import annotations
+
+from gyro.cli.common import add_out, add_points, add_quiet, add_set, check_png_out, model_with_equilibrium, parse_sets
+from gyro.models import ParameterError
+
+ORDER = 30
+
+
+def register(sub) -> None:
+    s = sub.add_parser("stability-map", help="stability of the equilibrium over two parameters")
+    s.add_argument("model")
+    add_set(s, help=None)
+    s.add_argument("--x", required=True, metavar="NAME")
+    s.add_argument("--x-range", nargs=2, type=float, required=True, metavar=("LO", "HI"))
+    s.add_argument("--y", required=True, metavar="NAME")
+    s.add_argument("--y-range", nargs=2, type=float, required=True, metavar=("LO", "HI"))
+    add_points(s, 60, "grid points per axis (default: 60)")
+    s.add_argument("--x-log", action="store_true", help="log-spaced x axis (needs 0 < LO)")
+    s.add_argument("--y-log", action="store_true", help="log-spaced y axis (needs 0 < LO)")
+    add_out(s, help=None)
+    add_quiet(s)
+    s.set_defaults(run=run)
+
+
+def run(args) -> int:
+    from gyro.analyses.stability_map import stability_grid
+
+    model = model_with_equilibrium(args.model)
+    values = model.parameters(parse_sets(args.set))
+    for axis, name, (lo, hi), log in (("--x", args.x, args.x_range, args.x_log),
+                                      ("--y", args.y, args.y_range, args.y_log)):
+        if name not in model.param_names:
+            raise ParameterError(f"{axis} {name!r}: unknown parameter; known: {' '.join(model.param_names)}")
+        if not lo < hi:
+            raise ParameterError(f"{axis}-range: need LO < HI, got {lo} {hi}")
+        if log and not lo > 0:
+            raise ParameterError(f"{axis}-range: {axis}-log needs 0 < LO, got {lo}")
+        for v in (lo, hi):
+            model.parameters({name: v})  # validates the ends of the range
+    if args.points < 2:
+        raise ParameterError(f"--points: need at least 2, got {args.points}")
+    out = check_png_out(args.out)
+    grid = stability_grid(model, values, args.x, args.x_range, args.y, args.y_range,
+                          args.points, progress=not args.quiet, xlog=args.x_log, ylog=args.y_log)
+    grid.plot(out)
+    print(grid.summary(out))
+    return 0

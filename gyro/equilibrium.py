@@ -1,0 +1,113 @@
+"""The one equilibrium solver: relative equilibria of a batch of parameter sets by
+Newton's method from the paper's approximation (2.2) (zero where the model has none), with
+the operator's stiffness K as the Jacobian, vectorised over the batch.
+
+Steps on angles are damped to MAX_ANGLE_STEP so that each set stays on the branch it
+starts from; a set whose K is singular takes a least-squares step (g = 0 leaves the azimuth
+free); a set that has not converged after MAX_ITER steps is accepted when its residual is
+below 1e-9 (1 + max |p|), as an exact but ill-conditioned equilibrium is; inputs whose
+operator is beyond double precision never reach LAPACK."""
+from __future__ import annotations
+
+import numpy as np
+
+from gyro.kernels import function
+from gyro.models import Model
+
+
+class EquilibriumError(RuntimeError):
+    pass
+
+
+MAX_ANGLE_STEP = 0.2  # rad: Newton steps on angles are damped to stay on the branch of (2.2)
+MAX_ITER = 100
+TOL = 1e-14
+
+
+def wrap(angle):
+    """Angles into (-pi, pi]; angles already there are returned untouched (adding and
+    subtracting pi would cost a small angle its relative precision)."""
+    angle = np.asarray(angle, dtype=float)
+    out = (angle + np.pi) % (2 * np.pi) - np.pi
+    return np.where(np.abs(angle) <= np.pi, angle, out)
+
+
+def tame(X) -> np.ndarray:
+    """Per matrix of a batch (or for one matrix): finite and far from overflow (LAPACK
+    squares entries while scaling; beyond 1e150 it overflows and complains on stderr)."""
+    X = np.asarray(X)
+    with np.errstate(invalid="ignore"):
+        return np.all(np.abs(X) < 1e150, axis=(-2, -1))
+
+
+def _layout(model: Model):
+    reduced = model.meta["reduced"]
+    names = model.meta["equilibrium_coordinates"]
+    idx = np.array([reduced.index(c) for c in names], dtype=int)
+    units = model.meta.get("coordinate_units", {})
+    return names, idx, np.array([units.get(c) == "rad" for c in names], dtype=bool)
+
+
+def equilibria(model: Model, P: np.ndarray, tol: float = TOL, max_iter: int = MAX_ITER):
+    """Relative equilibria of a batch P (sets, parameters). Returns (qe, ok): qe (sets,
+    equilibrium coordinates), NaN where ok is False."""
+    P = np.atleast_2d(np.asarray(P, dtype=float))
+    names, idx, is_angle = _layout(model)
+    n = P.shape[0]
+    if "equilibrium_approx" in model.meta["functions"]:
+        with np.errstate(all="ignore"):
+            qe = function(model, "equilibrium_approx")(P)[0].reshape(n, -1)
+        qe = np.where(np.isfinite(qe), qe, 0.0)  # (2.2) divides by g: at g = 0 start from zero
+    else:
+        qe = np.zeros((n, len(names)))
+    resid, oper = function(model, "equilibrium_residual"), function(model, "operator")
+    active = np.ones(n, bool)
+    converged = np.zeros(n, bool)
+    for _ in range(max_iter):
+        a = np.flatnonzero(active)
+        if a.size == 0:
+            break
+        with np.errstate(all="ignore"):
+            r = resid(P[a], qe[a])[0].reshape(a.size, -1)[:, idx]
+            K = oper(P[a], qe[a])[2][:, idx][:, :, idx]
+            ok_in = tame(K) & np.all(np.abs(r) < 1e150, axis=1)
+            K = np.where(ok_in[:, None, None], K, np.eye(len(idx)))
+            r = np.where(ok_in[:, None], r, np.nan)
+            # r(q + dq) = r(q) - K dq  (r = dR/dq, K = -d2R/dq2)
+            try:
+                dq = np.linalg.solve(K, r[..., None])[..., 0]
+            except np.linalg.LinAlgError:  # a singular K somewhere: least squares set by set
+                dq = np.array([np.linalg.lstsq(k, v, rcond=None)[0] if t else v
+                               for k, v, t in zip(K, r, ok_in)])
+        big = np.max(np.abs(np.where(is_angle, dq, 0.0)), axis=1, initial=0.0)
+        dq *= np.minimum(1.0, MAX_ANGLE_STEP / np.maximum(big, 1e-300))[:, None]
+        qe[a] += dq
+        bad = ~np.all(np.isfinite(qe[a]), axis=1)
+        conv = np.all(np.abs(dq) <= tol * np.maximum(np.abs(qe[a]), 1e-300) + 1e-300, axis=1)
+        converged[a[conv & ~bad]] = True
+        active[a[conv | bad]] = False
+        qe[a[bad]] = np.nan
+    ok = np.all(np.isfinite(qe), axis=1) & converged
+    late = np.flatnonzero(~converged & np.all(np.isfinite(qe), axis=1))
+    if late.size:  # not converged in max_iter: an exact equilibrium that Newton circles
+        with np.errstate(all="ignore"):
+            r = resid(P[late], qe[late])[0].reshape(late.size, -1)[:, idx]
+        ok[late] = np.max(np.abs(r), axis=1, initial=0.0) <= 1e-9 * (1 + np.max(np.abs(P[late]), axis=1))
+    qe = np.where(is_angle, wrap(qe), qe)
+    qe[~ok] = np.nan
+    return qe, ok
+
+
+def equilibrium(model: Model, params) -> np.ndarray:
+    """The relative equilibrium of one parameter set (metadata 'equilibrium_coordinates'),
+    or EquilibriumError."""
+    qe, ok = equilibria(model, np.asarray(params, dtype=float)[None, :])
+    if not ok[0]:
+        raise EquilibriumError("Newton's method did not converge")
+    return qe[0]
+
+
+def operators(model: Model, P: np.ndarray, qe: np.ndarray):
+    """M, D, K of a batch at its equilibria."""
+    with np.errstate(all="ignore"):
+        return function(model, "operator")(P, qe)

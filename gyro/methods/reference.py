@@ -1,0 +1,94 @@
+"""``reference``: equilibrium, operator and eigenvalues in arbitrary precision (mpmath, 40
+digits), each root polished by Newton on det J in the same precision; the estimate is the
+size of the last Newton step."""
+from __future__ import annotations
+
+import mpmath
+import numpy as np
+
+from gyro import qep
+from gyro.equilibrium import EquilibriumError, equilibria
+from gyro.models import Model
+from gyro.results import Spectrum
+
+NAME = "reference"
+RUNG = 5
+COST = 0.63  # s per set (bench/results/ladder.json)
+DPS = 40
+
+
+def _mp_equilibrium(mf, p, q0, idx, max_iter=60):
+    q = [mpmath.mpf(v) for v in q0]
+    tol = mpmath.mpf(10) ** (-mpmath.mp.dps + 5)
+    for _ in range(max_iter):
+        r = mf.equilibrium_residual(p, q)
+        _, _, K = mf.operator(p, q)
+        Kee = mpmath.matrix([[K[i, j] for j in idx] for i in idx])
+        dq = mpmath.lu_solve(Kee, mpmath.matrix([r[i] for i in idx]))
+        q = [qi + dqi for qi, dqi in zip(q, dq)]
+        if all(abs(d) <= tol * max(abs(v), mpmath.mpf(10) ** -300) for d, v in zip(dq, q)):
+            return q
+    raise EquilibriumError("Newton's method in extended precision did not converge")
+
+
+def _reference_roots(mf, p, start, idx):
+    """One set in the working precision: (roots, their last Newton steps relative, q)."""
+    q = _mp_equilibrium(mf, p, start, idx)
+    M, D, K = mf.operator(p, q)
+    n = M.rows
+    Minv = mpmath.inverse(M)
+    A = mpmath.zeros(2 * n, 2 * n)
+    B, C = -Minv * K, -Minv * D
+    for i in range(n):
+        A[i, n + i] = 1
+        for j in range(n):
+            A[n + i, j], A[n + i, n + j] = B[i, j], C[i, j]
+    lams = mpmath.eig(A, left=False, right=False)
+    lam_c = np.array([complex(v) for v in lams])
+    roots, steps = [], []
+    for r in qep.representatives(lam_c, n):
+        lam = lams[int(np.argmin(np.abs(lam_c - r)))]
+        J = M * lam**2 + D * lam + K
+        dJ = M * (2 * lam) + D
+        Jinv = mpmath.inverse(J)
+        step = 1 / sum(Jinv[c, i] * dJ[i, c] for c in range(n) for i in range(n))
+        lam = lam - step
+        roots.append(lam)
+        steps.append(abs(step) / abs(lam) if lam != 0 else mpmath.inf)
+    return roots, steps, q
+
+
+def solve(model: Model, P: np.ndarray, tol: float | None = None, dps: int = DPS) -> Spectrum:
+    """Arbitrary precision: the equilibrium by Newton from the double one, the companion
+    eigenvalues by mpmath.eig, each root polished by Newton on det J (trace of J^-1 J').
+    The estimate is the last Newton step, floored at 10^(5 - dps), plus the effect of the
+    inputs' rounding in this precision where a root lies far below the others."""
+    mf = model.mpmath
+    reduced = model.meta["reduced"]
+    idx = [reduced.index(c) for c in model.meta["equilibrium_coordinates"]]
+    N = P.shape[0]
+    qe_d, ok = equilibria(model, P)
+    out = None
+    with mpmath.workdps(dps):
+        for k in range(N):
+            p = [mpmath.mpf(float(v)) for v in P[k]]
+            if not ok[k]:  # equilibria() has tried the set-by-set solver as well
+                raise EquilibriumError(f"no equilibrium in double precision to start from (set {k})")
+            start = qe_d[k]
+            roots, steps, q = _reference_roots(mf, p, start, idx)
+            n = len(roots)
+            if out is None:
+                out = [np.full((N, n), np.nan), np.full((N, n), np.nan), np.full((N, n), np.inf),
+                       np.full((N, len(idx)), np.nan)]
+            lam = np.array([complex(r) for r in roots])
+            est = np.maximum(np.array([float(x) for x in steps]), 10.0 ** (5 - dps))
+
+            def solve_moved(_, p=p, start=start):  # the same move, in this precision
+                moved = qep.moved(p, mpmath.mpf(10) ** (3 - dps))
+                return [complex(r) for r in _reference_roots(mf, moved, start, idx)[0]]
+
+            est = est + qep.input_rounding(model, P[k], lam, solve_moved)
+            out[0][k], out[1][k], out[2][k] = np.abs(lam.imag), lam.real, est
+            out[3][k] = [float(v) for v in q]
+    f, g, e = qep.sort_spectrum(out[0], out[1], out[2])
+    return Spectrum("reference", f, g, e, out[3])

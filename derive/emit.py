@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 from dataclasses import dataclass
 from importlib import metadata as importlib_metadata
 from pathlib import Path
@@ -30,7 +31,8 @@ from derive.model import Function
 
 ROOT = Path(__file__).resolve().parent.parent
 TEMPLATES = ROOT / "templates"
-TOOL_VERSIONS = ("sympy", "symengine", "casadi")
+TOOL_VERSIONS = ("sympy", "symengine", "casadi", "jinja2")
+IDENT = re.compile(r"[A-Za-z][A-Za-z0-9_]*\Z")
 
 
 # --------------------------------------------------------------------------- printers
@@ -231,14 +233,31 @@ def input_hash(model_module_file: Path) -> str:
     return h.hexdigest()
 
 
+GROUP_RESERVED = {"n", "k", "i"}  # the batch entry point's count and loop index, the output loop
+
+
 def check_names(functions: list[Function]) -> None:
-    """Every input symbol of every function can be emitted, and none is an input twice."""
+    """Every function, input group, input symbol and output can be emitted: identifiers that
+    no keyword, macro or name of the generated code shadows, function names distinct, no
+    symbol an input twice and no group named like a symbol of its function."""
     from derive.model import Unsupported
     from derive.names import problem
 
+    seen_fn = set()
     for fn in functions:
+        why = problem(fn.name)
+        if why:
+            raise Unsupported(f"function {fn.name!r} cannot be emitted: {why}")
+        if fn.name in seen_fn:
+            raise Unsupported(f"function {fn.name!r} is emitted twice (a quantity named like an output kind?)")
+        seen_fn.add(fn.name)
+        symbols = {str(s) for _, syms in fn.inputs for s in syms}
         seen = set()
         for group, syms in fn.inputs:
+            if not IDENT.match(group) or group in GROUP_RESERVED or group in symbols or problem(group) not in (
+                    None, "a name the generated code uses for its inputs or loops"):
+                raise Unsupported(f"{fn.name}: input group {group!r} cannot be emitted (an identifier that is "
+                                  "no keyword, no n, k, i, and not the name of one of its symbols)")
             for s in syms:
                 why = None if group == "pval" else problem(str(s))  # pval: the machinery's p
                 if why:
@@ -246,6 +265,10 @@ def check_names(functions: list[Function]) -> None:
                 if str(s) in seen:
                     raise Unsupported(f"{fn.name}: input {s} appears twice")
                 seen.add(str(s))
+        outs = [o for o, _ in fn.outputs]
+        for o in outs:
+            if not IDENT.match(o) or len(set(outs)) != len(outs):
+                raise Unsupported(f"{fn.name}: output {o!r} cannot be emitted (an identifier, once)")
 
 
 def _operator_dim(functions: list[Function]) -> int:

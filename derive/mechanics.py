@@ -224,7 +224,11 @@ def load_forces(vector, velocity, qd) -> list:
 
 
 def is_cyclic(L, coordinate) -> bool:
-    return _se(L).diff(_se(coordinate)) == 0
+    """L does not depend on the coordinate: its derivative vanishes, to the letter or after
+    simplification (a kinetic energy written in body rates, A (w1^2 + w2^2), carries the
+    spin angle through sin^2 + cos^2)."""
+    d = _se(L).diff(_se(coordinate))
+    return d == 0 or se.expand(d) == 0 or sp.simplify(_sp(d)) == 0
 
 
 def cyclic_integral(L, velocity):

@@ -21,17 +21,31 @@ p_im z i numpy mpmath ca casadi math""".split())
 MATH_NAMES = set("""sin cos tan asin acos atan atan2 sinh cosh tanh exp log log10 sqrt fabs pow
 abs floor ceil fmod hypot cbrt erf gamma_fn M_PI NAN INFINITY HUGE_VAL""".split())
 TEMP = re.compile(r"t\d+\Z")  # common-subexpression temporaries
+# macros of <math.h> (C99 and the GNU and POSIX extensions): a local of that name is
+# replaced by the preprocessor
+MATH_MACRO = re.compile(r"(M_[A-Za-z0-9_]+|FP_[A-Z_]+|MATH_ERR[A-Z]*|math_errhandling|HUGE_VAL[FL]?|"
+                        r"INFINITY|NAN|isnan|isinf|isfinite|isnormal|signbit|fpclassify)\Z")
+
+
+def _printer_reserved() -> set:
+    """Words the SymPy printers of the emitter rename (C99 prints `entry` as `entry_`)."""
+    from sympy.printing.c import C99CodePrinter
+    from sympy.printing.pycode import MpmathPrinter, PythonCodePrinter
+
+    return set(C99CodePrinter.reserved_words) | set(PythonCodePrinter.reserved_words) | set(
+        MpmathPrinter.reserved_words)
 
 
 def problem(name: str) -> str | None:
     """None if `name` can be emitted, else why not."""
     if not IDENTIFIER.match(name):
         return "not an identifier (letters, digits and _, starting with a letter)"
-    if name in C_KEYWORDS or keyword.iskeyword(name) or keyword.issoftkeyword(name):
+    if (name in C_KEYWORDS or keyword.iskeyword(name) or keyword.issoftkeyword(name)
+            or name in _printer_reserved()):
         return "a keyword of C or Python"
     if name in TEMPLATE_NAMES:
         return "a name the generated code uses for its inputs or loops"
-    if name in MATH_NAMES:
+    if name in MATH_NAMES or MATH_MACRO.match(name):
         return "the name of a math function or constant of the generated code"
     if TEMP.match(name) or name.startswith("out_"):
         return "the form of the generated code's temporaries and outputs (t0, t1, ..., out_*)"

@@ -142,9 +142,42 @@ def generalized_forces(model: Model) -> list | None:
     return Q
 
 
-def _check_reducible(model: Model, L0, Q0, Q=None) -> None:
+def _given_symbols(model: Model) -> dict:
+    """Given functions of a coordinate (and their derivatives) -> the input symbols that
+    stand for their values in the emitted equations."""
+    given = {}
+    for fn, val, dval in zip(model.given_functions, model.given_values, model.given_derivatives):
+        given[sp.Derivative(fn, fn.args[0])] = dval
+        given[fn] = val
+    return given
+
+
+def _check_declared(model: Model, L, Q) -> None:
+    """Every symbol of the Lagrangian and the forces is declared: a parameter, a coordinate
+    or its rate, a momentum, a signal, a given value or constant, or time."""
+    known = set(model.symbols) | set(model.q) | set(model.qd) | set(model.signal_symbols) | {TIME}
+    known |= set(model.given_values) | set(model.given_derivatives) | set(model.given_constants)
+    known |= {s for s in model.cyclic.values() if isinstance(s, sp.Symbol)}
+    known |= set().union(*[sp.sympify(r).free_symbols for r in model.steady.values()]) if model.steady else set()
+    free = set(L.free_symbols).union(*[sp.sympify(x).free_symbols for x in (Q or [])])
+    unknown = sorted(map(str, free - known))
+    if unknown:
+        raise Unsupported(f"{model.name}: {', '.join(unknown)} in the Lagrangian or the forces is not declared "
+                          "(not a parameter, coordinate, rate, signal or momentum)")
+    for cname, r in model.steady.items():
+        bad = sorted(map(str, sp.sympify(r).free_symbols - set(model.symbols)))
+        if bad:
+            raise Unsupported(f"{model.name}: the steady rate of {cname} uses {', '.join(bad)}, not parameters")
+
+
+def _check_reducible(model: Model, L0, Q0, L_in, Q) -> None:
     """Routh reduction needs each cyclic coordinate ignorable with a conserved momentum; a
-    steady motion needs its turning coordinates ignorable. Anything else is refused."""
+    steady motion needs its turning coordinates ignorable. Anything else is refused. L_in
+    and Q are the Lagrangian (given functions as their input symbols) and the forces with
+    the inputs: an input that depends on such a coordinate would make B a function of it
+    (of time, along the motion), and one in its equation would change its momentum.
+    Returns the Lagrangian with every such coordinate proved absent set to zero (an
+    expression can carry one that cancels only by sin^2 + cos^2 = 1)."""
     if model.nonholonomic:
         raise Unsupported(f"{model.name}: nonholonomic constraints are not supported (the machinery "
                           "has no multipliers): write the system in independent coordinates")
@@ -154,15 +187,19 @@ def _check_reducible(model: Model, L0, Q0, Q=None) -> None:
     both = set(model.cyclic) & set(model.steady)
     if both:
         raise Unsupported(f"{model.name}: {sorted(both)} both Routh-reduced and turning steadily")
-    signal_syms = set(model.signal_symbols)
+    if len(model.cyclic) == len(model.coordinates):
+        raise Unsupported(f"{model.name}: every coordinate is cyclic; nothing is left to linearise")
     for cname in list(model.cyclic) + list(model.steady):
         c, v = model.coordinate(cname), model.velocity(cname)
         what = "cyclic" if cname in model.cyclic else "turning steadily"
         if not mech.is_cyclic(L0, c):
             raise Unsupported(f"{model.name}: {cname} ({what}) appears in the Lagrangian")
-        if Q0 is not None:
+        L0 = L0.subs(c, 0)
+        if L_in is not None and not mech.is_cyclic(L_in, c):
+            raise Unsupported(f"{model.name}: an input term of the Lagrangian depends on {cname} ({what})")
+        if Q is not None:
             k = model.coordinates.index(cname)
-            if any(sp.sympify(Qi).has(c) for Qi in Q0):
+            if any(sp.sympify(Qi).has(c) for Qi in Q):
                 raise Unsupported(f"{model.name}: a generalised force depends on {cname} ({what})")
             if cname in model.cyclic and (sp.sympify(Q[k]) != 0 or any(sp.sympify(Qi).has(v) for Qi in Q)):
                 raise Unsupported(f"{model.name}: a force acts on the cyclic coordinate {cname} or "
@@ -170,9 +207,10 @@ def _check_reducible(model: Model, L0, Q0, Q=None) -> None:
                                   "steady motion of it instead")
         if cname in model.cyclic:
             p = sp.diff(model.lagrangian, v)
-            if p.free_symbols & signal_syms & set(model.input_signal_symbols) or any(
+            if p.free_symbols & set(model.input_signal_symbols) or any(
                     p.has(fn) for fn in model.given_functions):
                 raise Unsupported(f"{model.name}: an input enters the momentum of the cyclic {cname}")
+    return L0
 
 
 def derive(model: Model, steps: Steps | None = None) -> Derivation:
@@ -184,11 +222,15 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
     with steps("checks: names, what the machinery supports"):
         names.check_model(model)
         Q = generalized_forces(model)
+        given = _given_symbols(model)
         zero_inputs = {s: 0 for s in model.input_signal_symbols}
         free = {fn: 0 for fn in model.given_functions}  # free vibration
         L0 = L.subs(free).subs(zero_inputs) if zero_inputs else L.subs(free)
         Q0 = None if Q is None else [sp.sympify(x).subs(zero_inputs) for x in Q]
-        _check_reducible(model, L0, Q0, Q)
+        L_inputs = L - L0  # the terms with inputs: given functions, input signals
+        L_in = sp.sympify(mech.substitute([L_inputs], given)[0] if given else L_inputs)
+        _check_declared(model, L_in + L0, Q)
+        L0 = _check_reducible(model, L0, Q0, L_in, Q)
         time_dependent = TIME in sp.sympify(L).free_symbols or any(
             TIME in sp.sympify(x).free_symbols for x in (Q or []))
 
@@ -201,18 +243,16 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
 
     with steps("equations of all coordinates, mass-matrix form"):
         Mq, f = mech.mass_matrix_form(L, q, qd, Q, signals)
-        given = {}
-        for fn, val, dval in zip(model.given_functions, model.given_values, model.given_derivatives):
-            arg = fn.args[0]
-            given[sp.Derivative(fn, arg)] = dval
-            given[fn] = val
         f = sp.Matrix(mech.substitute(list(f), given))
 
     R = L0
     with steps(f"Routh reduction of the cyclic coordinates {', '.join(model.cyclic)}" if model.cyclic
                else "Routh reduction: no cyclic coordinates"):
         for cname, momentum in model.cyclic.items():
-            R = mech.routhian(R, model.velocity(cname), momentum)
+            try:
+                R = mech.routhian(R, model.velocity(cname), momentum)
+            except ValueError as exc:  # not quadratic in the cyclic rate
+                raise Unsupported(f"{model.name}: Routh reduction of {cname}: {exc}") from None
 
     order = model.reduced or [c for c in model.coordinates if c not in model.cyclic]
     rq = [model.coordinate(c) for c in order]
@@ -228,7 +268,11 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
         for c in model.symmetric_zero:
             r = sp.expand(residual[order.index(c)])
             if r != 0:
-                raise AssertionError(f"equilibrium equation of {c} does not vanish on the symmetric set: {r}")
+                raise Unsupported(f"{model.name}: the equilibrium equation of {c} does not vanish on "
+                                  f"the symmetric set: {r}")
+        # a row that no equilibrium coordinate enters (a steady coordinate's) can still hold
+        # for some parameters (a drive torque balancing friction): the runtime checks it
+        # at each set and reports no equilibrium where it does not (gyro.equilibrium)
 
     with steps("linear operator, route 2: second variation of the Routhian, forces linearised"):
         op2 = mech.quadratic_expansion(R, rq, rqd, at=zero_set, rates=rates, signals=signals)
@@ -262,12 +306,10 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
     w = list(model.given_values) + list(model.given_derivatives) + list(model.input_signal_symbols)
     if w:
         with steps("input matrix B: the equations' Jacobian in the inputs at the reference"):
-            Lin = (L - L.subs(free)) if model.given_functions else sp.Integer(0)
-            if zero_inputs:
-                Lin = Lin + (L.subs(free) - L0)
-            Lin = mech.substitute([Lin], given)[0] if given else Lin
+            # the equations of the input terms (given functions still functions, so that
+            # their time derivatives are taken), then the functions' values as inputs
             Qin = None if Q is None else [sp.sympify(a) - b for a, b in zip(Q, Q0)]
-            Ein = mech.lagrange_equations(Lin, q, qd, qdd, Qin, signals)
+            Ein = mech.lagrange_equations(L_inputs, q, qd, qdd, Qin, signals)
             Ein = mech.substitute(Ein, given) if given else Ein
             if model.cyclic:
                 Ein = mech.eliminate_cyclic(Ein, q, qd, qdd, cyc_idx, L0, list(model.cyclic.values()), signals)

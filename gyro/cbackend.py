@@ -52,24 +52,30 @@ def _available() -> None:
 
 
 @lru_cache(maxsize=None)
-def _cached(cls, *args):
+def _cached(cls, directory, *args):
     return cls(*args)
 
 
-def _built(cls, *args):
-    """One instance per (class, arguments), built on first use, unless disabled()."""
+def _built(cls, model_name, *args):
+    """One instance per (class, the model's folder, arguments), built on first use, unless
+    disabled(). The folder is part of the key: two models of one name emitted into two
+    folders (an edited model file, say) never share compiled code."""
     _available()
-    return _cached(cls, *args)
+    return _cached(cls, str(load(model_name).directory), model_name, *args)
 
 
 def cache_dir() -> Path:
     return Path(os.environ.get("GYRO_CACHE", Path.home() / ".cache" / "gyro-dynamics"))
 
 
-@lru_cache(maxsize=None)
 def library(model_name: str) -> ctypes.CDLL:
-    """The compiled library of a model's generated C (built on first use)."""
-    src = load(model_name).directory / f"{model_name}.c"
+    """The compiled library of a model's generated C (built on first use, once per folder)."""
+    return _library(str(load(model_name).directory), model_name)
+
+
+@lru_cache(maxsize=None)
+def _library(directory: str, model_name: str) -> ctypes.CDLL:
+    src = Path(directory) / f"{model_name}.c"
     hdr = src.with_suffix(".h")
     cc = os.environ.get("CC", "gcc")
     if shutil.which(cc) is None:

@@ -5,8 +5,10 @@ the operator's stiffness K as the Jacobian, vectorised over the batch.
 Steps on angles are damped to MAX_ANGLE_STEP so that each set stays on the branch it
 starts from; a set whose K is singular takes a least-squares step (g = 0 leaves the azimuth
 free); a set that has not converged after MAX_ITER steps is accepted when its residual is
-below 1e-9 (1 + max |p|), as an exact but ill-conditioned equilibrium is; inputs whose
-operator is beyond double precision never reach LAPACK."""
+below 1e-9 (1 + max |p|), as an exact but ill-conditioned equilibrium is; the equation of
+a steadily turning coordinate, which no unknown enters, must hold to the same bound (a
+drive balancing friction at these parameters) or the set has no reference motion; inputs
+whose operator is beyond double precision never reach LAPACK."""
 from __future__ import annotations
 
 import numpy as np
@@ -93,6 +95,12 @@ def equilibria(model: Model, P: np.ndarray, tol: float = TOL, max_iter: int = MA
         with np.errstate(all="ignore"):
             r = resid(P[late], qe[late])[0].reshape(late.size, -1)[:, idx]
         ok[late] = np.max(np.abs(r), axis=1, initial=0.0) <= 1e-9 * (1 + np.max(np.abs(P[late]), axis=1))
+    steady = [model.meta["reduced"].index(c) for c in model.meta.get("steady", {})]
+    if steady and ok.any():  # a steady coordinate's row: no unknown enters it, it must hold itself
+        k = np.flatnonzero(ok)
+        with np.errstate(all="ignore"):
+            r = resid(P[k], qe[k])[0].reshape(k.size, -1)[:, steady]
+        ok[k] = np.max(np.abs(r), axis=1) <= 1e-9 * (1 + np.max(np.abs(P[k]), axis=1))
     qe = np.where(is_angle, wrap(qe), qe)
     qe[~ok] = np.nan
     return qe, ok

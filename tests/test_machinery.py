@@ -105,7 +105,7 @@ def test_input_signal_gives_the_input_matrix():
     ({"signals": [Signal("sqrt", "N", "force")]}, "signal 'sqrt'"),
     ({"nonholonomic": ["rolling"]}, "nonholonomic"),
     ({"cyclic": {"x": sp.Symbol("px")}, "lagrangian": sp.Symbol("m") * sp.Symbol("x_d")**2 / 2},
-     "force acts on the cyclic coordinate x"),
+     "every coordinate is cyclic"),
     ({"steady": {"x": 1}}, "x \\(turning steadily\\) appears in the Lagrangian"),
     ({"generalized_forces": {"y": 1}}, "'y', which is not a coordinate"),
 ])
@@ -303,3 +303,160 @@ def test_gimbal_quantities_are_emitted_and_agree_with_the_runtime():
     U1, dU1, d2U1 = model.numpy.routh_function(P, [th0], [I["H"], I["L"]])
     assert abs(dU1) < 1e-12 * (abs(U1) + 1)  # a stationary motion: U1' = 0
     assert d2U1 == pytest.approx(gimbal.U1_second(p, th0, I["H"], I["L"]), rel=1e-12)
+
+
+# --------------------------------------------------------------------- found in review
+
+
+def _polar(**kw) -> Model:
+    """A particle in the plane in polar coordinates (r, ph), on a spring k to the origin."""
+    m, k, Om = sp.symbols("m k Om")
+    r, ph, rd, phd, rdd, phdd = sp.symbols("r ph r_d ph_d r_dd ph_dd")
+    base = dict(name="polar", title="polar", source="test", module=__name__,
+                parameters=[Parameter("m", "kg", 1.0, "mass"), Parameter("k", "N/m", 4.0, "spring"),
+                            Parameter("Om", "rad/s", 1.0, "rate", kind="real")],
+                coordinates=["r", "ph"], coordinate_units={"r": "m", "ph": "rad"},
+                q=[r, ph], qd=[rd, phd], qdd=[rdd, phdd],
+                lagrangian=m * (rd**2 + r**2 * phd**2) / 2 - k * r**2 / 2)
+    base.update(kw)
+    return Model(**base)
+
+
+def test_an_input_that_turns_with_a_steady_or_cyclic_coordinate_is_refused():
+    """A force u along the fixed x axis on a particle turning steadily in ph: B would be
+    (cos(Om t), -r sin(Om t)), a function of time, not the constant it would come out as."""
+    u = Signal("u", "N", "force along x", order=0)
+    r, ph, rd, phd = sp.symbols("r ph r_d ph_d")
+    v = sp.Matrix([rd * sp.cos(ph) - r * sp.sin(ph) * phd, rd * sp.sin(ph) + r * sp.cos(ph) * phd])
+    load = Load(sp.Matrix([u.symbol, 0]), v)
+    with pytest.raises(Unsupported, match="depends on ph"):
+        _derive(_polar(signals=[u], loads=[load], steady={"ph": sp.Symbol("Om")}))
+    lag = _polar().lagrangian + u.symbol * r * sp.cos(ph)
+    with pytest.raises(Unsupported, match="input term of the Lagrangian depends on ph"):
+        _derive(_polar(signals=[u], lagrangian=lag, steady={"ph": sp.Symbol("Om")}))
+    with pytest.raises(Unsupported, match="input term of the Lagrangian depends on ph"):
+        _derive(_polar(signals=[u], lagrangian=lag, cyclic={"ph": sp.Symbol("beta")}))
+
+
+def test_a_force_on_a_cyclic_coordinate_is_refused():
+    c = sp.Symbol("c")
+    params = _polar().parameters + [Parameter("c", "N m s", 0.1, "damping")]
+    with pytest.raises(Unsupported, match="force acts on the cyclic coordinate ph"):
+        _derive(_polar(parameters=params, dissipation=c * sp.Symbol("ph_d")**2 / 2, cyclic={"ph": sp.Symbol("beta")}))
+
+
+@pytest.mark.parametrize("kw, match", [
+    ({"lagrangian": sp.Symbol("m") * sp.Symbol("x_d")**2 / 2 - sp.Symbol("kk") * sp.Symbol("x")**2},
+     "kk in the Lagrangian or the forces is not declared"),
+    ({"parameters": [Parameter("entry", "kg", 1.0, "mass")]}, "parameter 'entry'"),
+    ({"parameters": [Parameter("FP_NAN", "kg", 1.0, "mass")]}, "parameter 'FP_NAN'"),
+    ({"parameters": [Parameter("M_E", "kg", 1.0, "mass")]}, "parameter 'M_E'"),
+    ({"quantities": {"forcing": (["params"], [("f", sp.Matrix([sp.Symbol("m")]))], "clash")}},
+     "emitted twice"),
+    ({"quantities": {"energy": ([("n", [sp.Symbol("x")])], [("E", sp.Matrix([sp.Symbol("x")]))], "n")}},
+     "input group 'n'"),
+    ({"quantities": {"energy": ([("x", [sp.Symbol("x")])], [("E", sp.Matrix([sp.Symbol("x")]))], "x")}},
+     "input group 'x'"),
+    ({"quantities": {"if": (["params"], [("E", sp.Matrix([sp.Symbol("m")]))], "keyword")}}, "function 'if'"),
+])
+def test_names_and_symbols_that_would_break_the_emitted_code_are_refused(kw, match):
+    model = _oscillator(**kw)
+    with pytest.raises(Unsupported, match=match):
+        d = _derive(model)
+        from derive.emit import check_names
+
+        check_names(pipeline.functions(d))
+
+
+def test_routh_reduction_refuses_what_it_cannot_reduce():
+    ph_d = sp.Symbol("ph_d")
+    with pytest.raises(Unsupported, match="not quadratic in ph_d"):
+        _derive(_polar(lagrangian=_polar().lagrangian + ph_d**4, cyclic={"ph": sp.Symbol("beta")}))
+    r_d = sp.Symbol("r_d")
+    with pytest.raises(Unsupported, match="every coordinate is cyclic"):
+        _derive(_polar(lagrangian=sp.Symbol("m") * (r_d**2 + ph_d**2) / 2,
+                       cyclic={"r": sp.Symbol("pr"), "ph": sp.Symbol("beta")}))
+
+
+def test_a_coordinate_absent_only_by_sin2_plus_cos2_is_ignorable():
+    """Body rates of a disc spinning by ph: w1^2 + w2^2 carries ph until simplified."""
+    r, ph, rd, phd = sp.symbols("r ph r_d ph_d")
+    w1, w2 = rd * sp.cos(ph), rd * sp.sin(ph)
+    model = _polar(lagrangian=sp.Symbol("m") * (w1**2 + w2**2) / 2 + sp.Symbol("m") * phd**2 / 2
+                   - sp.Symbol("k") * r**2 / 2, steady={"ph": sp.Symbol("Om")})
+    d = _derive(model)
+    assert d.operator.K == sp.Matrix([[sp.Symbol("k"), 0], [0, 0]])
+
+
+def test_a_second_folder_of_the_same_model_name_gets_its_own_compiled_code(tmp_path):
+    from gyro import cbackend
+    from gyro.models import load
+
+    for folder, momentum_k in (("a", "k"), ("b", "2*k")):
+        src = _write_model(tmp_path / folder / "cart.py", MODEL_FILE.format(name="cart", momentum="0")
+                           .replace(', generalized_forces={"th": tau.symbol}', "")
+                           .replace("- k * x**2 / 2", f"- {momentum_k} * x**2 / 2")) \
+            if (tmp_path / folder).mkdir() is None else None
+        proc = subprocess.run([sys.executable, "-m", "derive", "--model", str(src), "--out", str(tmp_path / folder / "out")],
+                              cwd=ROOT, capture_output=True, text=True)
+        assert proc.returncode == 0, proc.stderr
+    Ks = []
+    for folder in ("a", "b"):
+        load(tmp_path / folder / "out" / "cart")
+        Ks.append(cbackend.batch_function("cart", "operator")([[1.0, 3.0, 0.1]], np.empty((1, 0)))[2][0, 0, 0])
+    assert Ks == [3.0, 6.0]
+
+
+def test_a_model_file_may_import_a_module_beside_it(tmp_path):
+    (tmp_path / "helper_physics.py").write_text("def spring(k, x):\n    return k * x**2 / 2\n")
+    body = MODEL_FILE.format(name="cart", momentum="0").replace(', generalized_forces={"th": tau.symbol}', "")
+    body = body.replace("    import sympy as sp\n", "    import sympy as sp\n    from helper_physics import spring\n")
+    body = body.replace("- k * x**2 / 2", "- spring(k, x)")
+    src = _write_model(tmp_path / "cart.py", body)
+    proc = subprocess.run([sys.executable, "-m", "derive", "--model", str(src), "--out", str(tmp_path / "out")],
+                          cwd=ROOT, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+
+
+def test_a_build_that_raises_exits_2_in_one_line(tmp_path):
+    src = _write_model(tmp_path / "broken.py", "def build():\n    raise RuntimeError('no such body')\n")
+    proc = subprocess.run([sys.executable, "-m", "derive", "--model", str(src), "--out", str(tmp_path / "out")],
+                          cwd=ROOT, capture_output=True, text=True)
+    assert proc.returncode == 2 and "build() failed: RuntimeError: no such body" in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1
+
+
+def test_a_steady_motion_that_these_parameters_do_not_allow_has_no_equilibrium(tmp_path):
+    """A flywheel turning steadily against a damper with a drive torque tq: the reference is
+    a motion only where tq = c Om. Derived (a relation of the parameters), and the runtime
+    finds an equilibrium there and refuses one elsewhere, never a silent answer."""
+    body = '''
+    import sympy as sp
+    from derive.model import Model, Parameter
+
+    r, ph, r_d, ph_d, r_dd, ph_dd = sp.symbols("r ph r_d ph_d r_dd ph_dd")
+
+
+    def build():
+        m, k, c, Om, tq = sp.symbols("m k c Om tq")
+        return Model(
+            name="flywheel", title="flywheel on a spring", source="test", module=__name__,
+            parameters=[Parameter("m", "kg", 1.0, "mass"), Parameter("k", "N/m", 4.0, "spring"),
+                        Parameter("c", "N m s", 0.1, "damper"), Parameter("Om", "rad/s", 2.0, "rate"),
+                        Parameter("tq", "N m", 0.2, "drive torque", kind="real")],
+            coordinates=["r", "ph"], coordinate_units={"r": "m", "ph": "rad"},
+            q=[r, ph], qd=[r_d, ph_d], qdd=[r_dd, ph_dd],
+            lagrangian=m * r_d**2 / 2 + m * ph_d**2 / 2 - k * r**2 / 2,
+            dissipation=c * ph_d**2 / 2, generalized_forces={"ph": tq}, steady={"ph": Om})
+    '''
+    src = _write_model(tmp_path / "flywheel.py", body)
+    proc = subprocess.run([sys.executable, "-m", "derive", "--model", str(src), "--out", str(tmp_path / "out")],
+                          cwd=ROOT, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    from gyro.equilibrium import equilibria
+    from gyro.models import load
+
+    model = load(tmp_path / "out" / "flywheel")
+    P = np.array([[1.0, 4.0, 0.1, 2.0, 0.2], [1.0, 4.0, 0.1, 2.0, 0.3]])
+    qe, ok = equilibria(model, P)
+    assert ok.tolist() == [True, False] and qe[0, 0] == 0.0 and np.isnan(qe[1, 0])

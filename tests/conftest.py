@@ -16,13 +16,13 @@ MODEL = "torsion_gyrocompass"
 # Tiers (docs/architecture.md): each test file belongs to one, marked by its name, so that
 # `pytest -m unit` (make test-unit) runs the fast tier alone; `make test` runs them all.
 TIERS = {
-    "unit": ("test_mechanics", "test_machinery", "test_architecture"),
+    "unit": ("test_mechanics", "test_machinery", "test_architecture", "test_results"),
     "generated": ("test_generated", "test_textbook", "test_docs_models", "test_derivation"),
     "paper": ("test_paper", "test_anchors", "test_nonlinear", "test_gimbal", "test_gimbal_closed_form",
               "test_gimbal_section6", "test_gimbal_paper_items"),
     "methods": ("test_ladder",),
     "properties": ("test_properties",),
-    "cli": ("test_cli", "test_gimbal_simulate"),
+    "cli": ("test_cli", "test_gimbal_simulate", "test_readme", "test_sweep"),
 }
 _TIER_OF = {f: tier for tier, files in TIERS.items() for f in files}
 

@@ -1,6 +1,8 @@
 """`gyro campbell MODEL [--set NAME=VALUE]... --out FILE.png [--range LO HI] [--points N]`"""
 from __future__ import annotations
 
+import sys
+
 from gyro.cli.common import add_out, add_points, add_quiet, add_set, check_png_out, model_with_equilibrium, parse_sets
 from gyro.models import ParameterError
 
@@ -30,7 +32,7 @@ def run(args) -> int:
     if args.points < 2:
         raise ParameterError(f"--points: need at least 2, got {args.points}")
     out = check_png_out(args.out)
-    diagram = sweep(model, values, lo, hi, args.points, progress=not args.quiet)
+    diagram = sweep(model, values, lo, hi, args.points, progress=not args.quiet and sys.stderr.isatty())
     diagram.plot(out)
     print(diagram.summary(out))
     return 0

@@ -38,7 +38,7 @@ def add_points(p, default, help: str | None = None, type=int) -> None:
 
 
 def add_quiet(p) -> None:
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--quiet", action="store_true", help="no progress bar (none either when stderr is not a terminal)")
 
 
 def parse_sets(items: list[str]) -> dict[str, str]:

@@ -2,6 +2,8 @@
 [--y-log] --out FILE.png`"""
 from __future__ import annotations
 
+import sys
+
 from gyro.cli.common import add_out, add_points, add_quiet, add_set, check_png_out, model_with_equilibrium, parse_sets
 from gyro.models import ParameterError
 
@@ -43,7 +45,7 @@ def run(args) -> int:
         raise ParameterError(f"--points: need at least 2, got {args.points}")
     out = check_png_out(args.out)
     grid = stability_grid(model, values, args.x, args.x_range, args.y, args.y_range,
-                          args.points, progress=not args.quiet, xlog=args.x_log, ylog=args.y_log)
+                          args.points, progress=not args.quiet and sys.stderr.isatty(), xlog=args.x_log, ylog=args.y_log)
     grid.plot(out)
     print(grid.summary(out))
     return 0

@@ -1,0 +1,67 @@
+"""`gyro sweep MODEL --x NAME --x-range LO HI [--x-log] [--points N] [--method NAME]
+[--set NAME=VALUE]... [--json] [--out FILE.png]`: natural frequencies against one parameter."""
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+
+from gyro import ladder
+from gyro.cli.common import add_json, add_out, add_points, add_quiet, add_set, check_png_out, model_with_equilibrium, parse_sets
+from gyro.models import ParameterError
+
+ORDER = 35
+
+
+def register(sub) -> None:
+    s = sub.add_parser("sweep", help="natural frequencies against one parameter")
+    s.add_argument("model")
+    add_set(s)
+    s.add_argument("--x", required=True, metavar="NAME", help="the parameter swept")
+    s.add_argument("--x-range", nargs=2, type=float, required=True, metavar=("LO", "HI"))
+    s.add_argument("--x-log", action="store_true", help="log-spaced (needs 0 < LO)")
+    add_points(s, 50, "values of the parameter (default: 50)")
+    s.add_argument("--method", default="default", choices=ladder.METHODS, help="rung of the ladder")
+    add_json(s)
+    add_out(s, required=False, help="also plot the frequencies into FILE.png")
+    add_quiet(s)
+    s.set_defaults(run=run)
+
+
+def run(args) -> int:
+    from gyro.analyses.sweep import sweep
+
+    model = model_with_equilibrium(args.model)
+    values = model.parameters(parse_sets(args.set))
+    if args.x not in model.param_names:
+        raise ParameterError(f"--x {args.x!r}: unknown parameter; known: {' '.join(model.param_names)}")
+    lo, hi = args.x_range
+    if not lo < hi:
+        raise ParameterError(f"--x-range: need LO < HI, got {lo} {hi}")
+    if args.x_log and not lo > 0:
+        raise ParameterError(f"--x-range: --x-log needs 0 < LO, got {lo}")
+    for v in (lo, hi):
+        model.parameters({args.x: v})  # validates the ends of the range
+    if not 2 <= args.points <= 100_000:
+        raise ParameterError(f"--points: need 2..100000, got {args.points}")
+    if args.method == "formulas" and "mode_formulas" not in model.meta["functions"]:
+        raise ParameterError(f"--method formulas: {model.name} has no approximate formulas")
+    out = check_png_out(args.out) if args.out else None
+    result = sweep(model, values, args.x, lo, hi, args.points, args.method, args.x_log,
+                   progress=not args.quiet and sys.stderr.isatty())
+    if out is not None:
+        result.plot(out)
+    if args.json:
+        print(json.dumps(result.to_dict(), allow_nan=False))
+    elif out is not None:
+        print(result.summary(out))
+    else:
+        f = result.spectrum.frequencies
+        print(f"{'':>4} {args.x + ' [' + result.xunit + ']':>16} " + " ".join(f"{'omega' + str(j + 1):>12}" for j in range(f.shape[1])))
+        for i, xv in enumerate(result.x):
+            print(f"{i + 1:>4} {xv:>16.8g} " + " ".join(f"{w:>12.6g}" for w in f[i]))
+    if not np.all(np.isfinite(result.spectrum.frequencies)):
+        print("gyro: some values have no finite spectrum (NaN above)", file=sys.stderr)
+        return 1
+    return 0

@@ -1,0 +1,97 @@
+"""Result objects: each gives the command line's JSON and text, saves and loads itself,
+concatenates over batches, pickles, and plots itself."""
+from __future__ import annotations
+
+import json
+import pickle
+
+import numpy as np
+import pytest
+
+from gyro import ladder, load
+from gyro.analyses import campbell
+from gyro.analyses.gimbal import Motion, trajectory
+from gyro.analyses.stability_map import stability_grid
+from gyro.results import CampbellDiagram, ModalResult, Spectrum, StabilityMap, Trajectory
+
+MODEL = load("torsion_gyrocompass")
+
+
+def _batch(n=5):
+    P = np.tile(MODEL.vector(MODEL.defaults), (n, 1))
+    P[:, MODEL.param_names.index("H")] *= np.linspace(0.5, 2.0, n)
+    return P
+
+
+def test_spectrum_concatenates_saves_loads_and_pickles(tmp_path):
+    P = _batch(6)
+    whole = ladder.spectrum(MODEL, P)
+    parts = Spectrum.concat([ladder.spectrum(MODEL, P[:2]), ladder.spectrum(MODEL, P[2:])])
+    for f in ("frequencies", "growth", "error_estimate", "equilibrium"):
+        np.testing.assert_array_equal(getattr(parts, f), getattr(whole, f))
+    assert list(parts.route) == list(whole.route) and len(parts) == 6
+    whole.save(tmp_path / "s.npz")
+    back = Spectrum.load(tmp_path / "s.npz")
+    np.testing.assert_array_equal(back.frequencies, whole.frequencies)
+    assert list(back.route) == list(whole.route) and back.method == "default"
+    again = pickle.loads(pickle.dumps(whole))
+    np.testing.assert_array_equal(again.error_estimate, whole.error_estimate)
+
+
+def test_spectrum_gives_the_cli_json_and_text():
+    values = MODEL.parameters({"phi": 30})
+    spec = ladder.spectrum(MODEL, MODEL.vector(values))
+    doc = spec.to_dict(0, MODEL, values)
+    assert list(doc) == ["model", "params", "frequencies", "equilibrium", "eigenvalues_re", "method",
+                         "error_estimate", "stability"]
+    assert json.loads(json.dumps(doc, allow_nan=False)) == doc
+    assert spec.table(0, MODEL).splitlines()[-1] == "equilibrium: stable"
+
+
+def test_spectrum_plots_itself(tmp_path):
+    import matplotlib.pyplot as plt
+
+    ax = ladder.spectrum(MODEL, _batch()).plot()
+    assert len(ax.lines) == 10
+    plt.close("all")
+
+
+def test_modal_result_round_trip(tmp_path):
+    r = ladder.natural_frequencies(MODEL, MODEL.defaults)
+    r.save(tmp_path / "m.json")
+    assert ModalResult.load(tmp_path / "m.json") == r
+
+
+def test_campbell_diagram_plots_saves_and_pickles(tmp_path):
+    d = campbell.sweep(MODEL, MODEL.defaults, 0.5, 2.0, 6)
+    assert isinstance(d, CampbellDiagram) and d.formula_error.shape == (6, 10)
+    d.plot(tmp_path / "c.png")
+    assert (tmp_path / "c.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "6 spins" in d.summary("c.png")
+    np.testing.assert_array_equal(pickle.loads(pickle.dumps(d)).Omega, d.Omega)
+    d.save(tmp_path / "c.npz")
+
+
+def test_stability_map_plots_saves_and_loads(tmp_path):
+    m = stability_grid(MODEL, MODEL.defaults, "l2", (-0.3, 0.3), "H", (0.1, 1.0), 4)
+    assert isinstance(m, StabilityMap) and m.label.shape == (4, 4)
+    assert sum(m.counts().values()) == 16
+    m.plot(tmp_path / "m.png")
+    m.save(tmp_path / "m.npz")
+    back = StabilityMap.load(tmp_path / "m.npz")
+    assert back.label.tolist() == m.label.tolist() and back.xname == "l2"
+    np.testing.assert_array_equal(back.growth, m.growth)
+
+
+@pytest.mark.parametrize("method", ["closed_form", "DOP853"])
+def test_trajectory_gives_the_cli_json_saves_and_plots(method, tmp_path):
+    gg = load("gimbal_gyroscope")
+    tr = trajectory(Motion(gg.defaults, 1.2, 0.0, 1.0, 200.0), np.linspace(0, 0.2, 5), method)
+    assert isinstance(tr, Trajectory)
+    assert list(tr.to_dict()) == ["t", "theta", "psi", "phi", "method", "integrals"]
+    tr.save(tmp_path / "t.npz")
+    back = Trajectory.load(tmp_path / "t.npz")
+    np.testing.assert_array_equal(back.theta, tr.theta)
+    assert back.integrals == tr.integrals and back.method == method
+    tr.plot(tmp_path / "t.png")
+    assert (tmp_path / "t.png").exists()

@@ -137,6 +137,7 @@ def quantities():
     M_int = 2 * I["E"] - I["H"]**2 / A3  # the printed M of (1.2), an integral for any C0
     U1 = routh_function()
     b, g2, g3, Hm, Lm = closed_form_coefficients()
+    psi_rate = (L - H * sp.cos(theta)) / (A0 - C0 * sp.cos(theta)**2)
     return {
         "gravity_moment": (["params"], [("G", sp.Matrix([G]))], "G = P1 eta30 + P l (1.1)."),
         "first_integrals": (["params", "q", "qd"],
@@ -148,6 +149,14 @@ def quantities():
                            [("U1", sp.Matrix([U1, sp.diff(U1, theta), sp.diff(U1, theta, 2)]))],
                            "Routh's function U1(theta) (3.3) and its first and second derivatives "
                            "in theta: a stationary motion has U1' = 0, a stable one U1'' < 0."),
+        "rates_from_momenta": (["params", "qe", "momenta"],
+                               [("rates", sp.Matrix([psi_rate, H / A3 - psi_rate * sp.cos(theta)]))],
+                               "psi' and phi' at theta from the integrals (1.2): L = (A0 - C0 cos^2) psi' "
+                               "+ H cos theta, H = A3 (phi' + psi' cos theta)."),
+        "stationary_precession": (["params", "qe", ("spin", [H])],
+                                  [("dpsi", sp.Matrix([(G - P1 * eta20 * sp.cos(theta) / sp.sin(theta)) / H]))],
+                                  "psi0' of the stationary motion (3.1) at theta with rotor momentum H "
+                                  "(C0 = 0): (G - H psi0') sin theta = P1 eta20 cos theta."),
         "closed_form": (["params", ("initial", [theta0, dtheta0, dpsi0, dphi0])],
                         [("b", b), ("g", sp.Matrix([g2, g3])), ("HL", sp.Matrix([Hm, Lm]))],
                         "Section 2 at C0 = 0: b0..b4 of (ds/dtau)^2, the invariants g2, g3 of "

@@ -539,11 +539,21 @@ def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, at
 # ------------------------------------------------------------------ motions of section 3 and 6
 
 
+def _rates(params: dict, theta: float, H: float, L: float) -> tuple[float, float]:
+    """psi', phi' at theta from the integrals H, L (the generated `rates_from_momenta`)."""
+    r = load(MODEL).numpy.rates_from_momenta(param_vector(params), [theta], [H, L])
+    return float(r[0]), float(r[1])
+
+
 def stationary_motion(params: dict, theta0: float, H: float) -> Motion:
     """The stationary motion (3.1)-(3.2) at theta0 with rotor momentum H: theta0' = 0,
-    (G - H psi0') sin theta0 = P1 eta20 cos theta0, phi0' from H = A3 (phi' + psi' cos)."""
-    dpsi = (_gravity_moment(params) - params["P1"] * params["eta20"] / math.tan(theta0)) / H
-    return Motion(params, theta0, 0.0, dpsi, H / params["A3"] - dpsi * math.cos(theta0))
+    (G - H psi0') sin theta0 = P1 eta20 cos theta0 (the generated `stationary_precession`),
+    phi0' from H = A3 (phi' + psi' cos)."""
+    nf, P = load(MODEL).numpy, param_vector(params)
+    dpsi = float(nf.stationary_precession(P, [theta0], [H])[0])
+    # phi0' from the generated integral H, which is affine in phi'
+    H0, H1 = (float(nf.first_integrals(P, [0.0, theta0, 0.0], [dpsi, 0.0, w])[0]) for w in (0.0, 1.0))
+    return Motion(params, theta0, 0.0, dpsi, (H - H0) / (H1 - H0))
 
 
 def U1_second(params: dict, theta0: float, H: float, L: float) -> float:
@@ -559,8 +569,8 @@ def kick(motion: Motion, dtheta: float) -> Motion:
 def turning_motion(motion: Motion, theta_t: float) -> Motion:
     """A motion with the integrals H, L of `motion` that starts at rest in theta at theta_t."""
     p, I = motion.params, motion.integrals0
-    dpsi = (I["L"] - I["H"] * math.cos(theta_t)) / p["A0"]
-    return Motion(p, theta_t, 0.0, dpsi, I["H"] / p["A3"] - dpsi * math.cos(theta_t))
+    dpsi, dphi = _rates(p, theta_t, float(I["H"]), float(I["L"]))
+    return Motion(p, theta_t, 0.0, dpsi, dphi)
 
 
 def turning_points(motion: Motion, n: int = 4096) -> np.ndarray:

@@ -2,7 +2,7 @@
 the inertia sums of 2T from the three bodies (section 1), (2.4)/(2.5) and the w scaling
 (section 2), the global stability condition (section 3), V' of section 4, the sn(tau + K)
 diagnosis of section 5 and the multiple-root clauses of section 6. Verdicts:
-docs/paper_check_gimbal.md."""
+docs/paper_check.md (paper 000)."""
 from __future__ import annotations
 
 import numpy as np

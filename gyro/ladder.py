@@ -13,20 +13,19 @@ from __future__ import annotations
 import numpy as np
 
 from gyro.equilibrium import EquilibriumError, equilibrium
-from gyro.methods import registry
-from gyro.methods.default import DEFAULT_TOL
+from gyro.methods import DEFAULT_TOL, get, names
 from gyro.models import Model
 from gyro.results import ModalResult, Spectrum, Stability, classify
 
 __all__ = ["METHODS", "DEFAULT_TOL", "spectrum", "classify", "natural_frequencies", "cost",
            "Spectrum", "Stability", "as_batch"]
 
-METHODS = tuple(registry())  # in the ladder's order
+METHODS = names()  # in the ladder's order
 
 
 def cost(method: str) -> float:
     """A method's measured time per set (s, one core): what a selector weighs."""
-    return registry()[method].COST
+    return get(method).COST
 
 
 def as_batch(model: Model, params) -> np.ndarray:
@@ -43,7 +42,7 @@ def spectrum(model: Model, params, method: str = "default", tol: float = DEFAULT
     model.param_names) by one method of the ladder."""
     if method not in METHODS:
         raise ValueError(f"method: unknown {method!r}; known: {', '.join(METHODS)}")
-    return registry()[method].solve(model, as_batch(model, params), tol)
+    return get(method).solve(model, as_batch(model, params), tol)
 
 
 def natural_frequencies(model: Model, values: dict, method: str = "default") -> ModalResult:

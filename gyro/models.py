@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import math
 from dataclasses import dataclass
 from functools import cached_property
@@ -9,11 +10,10 @@ from pathlib import Path
 
 import numpy as np
 
-GENERATED = Path(__file__).resolve().parent.parent / "generated"
+from gyro.catalog import GENERATED_PACKAGE, available, generated_dir  # noqa: F401
+from gyro.errors import ParameterError
 
-
-class ParameterError(ValueError):
-    """Bad user input; the message is one line naming the parameter."""
+GENERATED = generated_dir()
 
 
 @dataclass(frozen=True)
@@ -49,7 +49,7 @@ class Model:
             known = available()
             if name not in known:
                 raise ParameterError(f"unknown model {name!r}; known: {', '.join(known)}")
-            package = f"generated.{name}"
+            package = f"{GENERATED_PACKAGE}.{name}"
             self.directory = GENERATED / name
         else:
             self.directory = Path(directory).resolve()
@@ -115,11 +115,6 @@ def _import_directory(directory: Path) -> str:
         sys.modules[name] = module
         spec.loader.exec_module(module)
     return name
-
-
-def available() -> list[str]:
-    """The generated models: folders of generated/ with a metadata.json."""
-    return sorted(p.name for p in GENERATED.iterdir() if (p / "metadata.json").exists())
 
 
 _CACHE: dict[str, Model] = {}

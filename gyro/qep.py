@@ -8,7 +8,6 @@ templates/qep.c.j2 and dispatched by gyro.kernels.
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg as sla
 
 from gyro import cbackend
 from gyro.equilibrium import equilibria, operators, tame
@@ -33,6 +32,8 @@ def companion_matrix(M, D, K):
 def companion_eigenvalues(M, D, K):
     # LAPACK balances A (D A D^-1), which evens out the rows of a spectrum spread over five
     # orders of magnitude, before its QR iteration
+    import scipy.linalg as sla  # imported where needed: the default rung rarely comes here
+
     return sla.eigvals(companion_matrix(M, D, K), check_finite=True, overwrite_a=True,
                        homogeneous_eigvals=False)
 

@@ -12,15 +12,13 @@ numerical failure at valid input one line and exit 1.
 """
 from __future__ import annotations
 
+import argparse
 import importlib
 import pkgutil
 import sys
 
-import numpy as np
-
 from gyro.cli.common import EXIT_USAGE, Parser
-from gyro.equilibrium import EquilibriumError
-from gyro.models import ParameterError
+from gyro.errors import ParameterError
 
 
 def commands() -> list:
@@ -29,8 +27,26 @@ def commands() -> list:
     return sorted((m for m in mods if hasattr(m, "register")), key=lambda m: m.ORDER)
 
 
+class _Version(argparse.Action):
+    """--version, looking the version up only when asked (importlib.metadata is slow)."""
+
+    def __init__(self, option_strings, dest, help=None):
+        super().__init__(option_strings, dest, nargs=0, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            v = version("gyro-dynamics")
+        except PackageNotFoundError:  # a source tree that was never installed
+            v = "unknown (not installed)"
+        print(f"gyro {v}")
+        parser.exit()
+
+
 def build_parser() -> Parser:
     ap = Parser(prog="gyro", description="Gyroscope dynamics from generated models.")
+    ap.add_argument("--version", action=_Version, help="print the installed version and exit")
     sub = ap.add_subparsers(dest="command", required=True, parser_class=Parser)
     for cmd in commands():
         cmd.register(sub)
@@ -39,6 +55,10 @@ def build_parser() -> Parser:
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
+    import numpy as np  # after parsing: `gyro --help` and usage errors import no NumPy
+
+    from gyro.equilibrium import EquilibriumError
+
     try:
         with np.errstate(all="ignore"):  # failures are caught below, one line each
             return args.run(args)

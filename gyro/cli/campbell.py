@@ -3,15 +3,15 @@ from __future__ import annotations
 
 import sys
 
-from gyro.cli.common import add_out, add_points, add_quiet, add_set, check_png_out, model_with_equilibrium, parse_sets
-from gyro.models import ParameterError
+from gyro.cli.common import add_model, add_out, add_points, add_quiet, add_set, check_png_out, model_with_equilibrium, parse_sets
+from gyro.errors import ParameterError
 
 ORDER = 20
 
 
 def register(sub) -> None:
     c = sub.add_parser("campbell", help="Campbell diagram: frequencies against spin, formulas overlaid")
-    c.add_argument("model")
+    add_model(c)
     add_set(c)
     add_out(c)
     c.add_argument("--range", nargs=2, type=float, default=(0.1, 10.0), metavar=("LO", "HI"),

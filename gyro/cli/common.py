@@ -7,7 +7,7 @@ import os
 import sys
 from pathlib import Path
 
-from gyro.models import ParameterError, load
+from gyro.errors import ParameterError
 
 EXIT_USAGE = 2
 SET_HELP = "parameter value in SI units (phi in degrees); repeat as needed"
@@ -19,6 +19,20 @@ class Parser(argparse.ArgumentParser):
     def error(self, message):
         print(f"{self.prog}: error: {message}", file=sys.stderr)
         sys.exit(EXIT_USAGE)
+
+
+def add_model(p, models=None, help="the model (gyro params MODEL lists its parameters)") -> None:
+    """The positional MODEL, its choices the generated models (or `models`)."""
+    from gyro.catalog import available
+
+    known = list(models or available())
+
+    def model_name(text: str) -> str:
+        if text not in known:
+            raise argparse.ArgumentTypeError(f"unknown model {text!r}; known: {', '.join(known)}")
+        return text
+
+    p.add_argument("model", type=model_name, metavar="MODEL", help=f"{help}; one of: {', '.join(known)}")
 
 
 def add_set(p, help: str | None = SET_HELP) -> None:
@@ -53,6 +67,8 @@ def parse_sets(items: list[str]) -> dict[str, str]:
 
 
 def model_with_equilibrium(name):
+    from gyro.models import load
+
     model = load(name)
     if model.meta.get("momenta"):
         raise ParameterError(f"{model.name}: its operator depends on the momenta "

@@ -3,26 +3,28 @@ from __future__ import annotations
 
 import json
 
-import numpy as np
-
-from gyro import ladder
-from gyro.cli.common import add_json, add_set, model_with_equilibrium, parse_sets
-from gyro.models import ParameterError
+from gyro.cli.common import add_json, add_model, add_set, model_with_equilibrium, parse_sets
+from gyro.errors import ParameterError
+from gyro.methods import names as method_names
 
 ORDER = 10
 
 
 def register(sub) -> None:
     f = sub.add_parser("frequencies", help="natural frequencies of a model's exact linear operator")
-    f.add_argument("model")
+    add_model(f)
     add_set(f)
     add_json(f)
-    f.add_argument("--method", default="default", choices=ladder.METHODS,
+    f.add_argument("--method", default="default", choices=method_names(),
                    help="rung of the ladder (default: %(default)s; docs/methods.md)")
     f.set_defaults(run=run)
 
 
 def run(args) -> int:
+    import numpy as np
+
+    from gyro import ladder
+
     model = model_with_equilibrium(args.model)
     values = model.parameters(parse_sets(args.set))
     if args.method == "formulas" and "mode_formulas" not in model.meta["functions"]:

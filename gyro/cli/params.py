@@ -1,18 +1,20 @@
 """`gyro params MODEL`"""
 from __future__ import annotations
 
-from gyro.models import load
+from gyro.cli.common import add_model
 
 ORDER = 40
 
 
 def register(sub) -> None:
     p = sub.add_parser("params", help="list a model's parameters with the paper example's values")
-    p.add_argument("model")
+    add_model(p)
     p.set_defaults(run=run)
 
 
 def run(args) -> int:
+    from gyro.models import load
+
     model = load(args.model)
     print(f"{'name':<8} {'default':>14} {'unit':<10} description")
     for p in model.params:

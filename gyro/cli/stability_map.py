@@ -4,24 +4,26 @@ from __future__ import annotations
 
 import sys
 
-from gyro.cli.common import add_out, add_points, add_quiet, add_set, check_png_out, model_with_equilibrium, parse_sets
-from gyro.models import ParameterError
+from gyro.cli.common import add_model, add_out, add_points, add_quiet, add_set, check_png_out, model_with_equilibrium, parse_sets
+from gyro.errors import ParameterError
 
 ORDER = 30
 
 
 def register(sub) -> None:
     s = sub.add_parser("stability-map", help="stability of the equilibrium over two parameters")
-    s.add_argument("model")
-    add_set(s, help=None)
-    s.add_argument("--x", required=True, metavar="NAME")
-    s.add_argument("--x-range", nargs=2, type=float, required=True, metavar=("LO", "HI"))
-    s.add_argument("--y", required=True, metavar="NAME")
-    s.add_argument("--y-range", nargs=2, type=float, required=True, metavar=("LO", "HI"))
+    add_model(s)
+    add_set(s)
+    s.add_argument("--x", required=True, metavar="NAME", help="the parameter along the x axis")
+    s.add_argument("--x-range", nargs=2, type=float, required=True, metavar=("LO", "HI"),
+                   help="its range, in its unit (gyro params MODEL)")
+    s.add_argument("--y", required=True, metavar="NAME", help="the parameter along the y axis")
+    s.add_argument("--y-range", nargs=2, type=float, required=True, metavar=("LO", "HI"),
+                   help="its range, in its unit")
     add_points(s, 60, "grid points per axis (default: 60)")
     s.add_argument("--x-log", action="store_true", help="log-spaced x axis (needs 0 < LO)")
     s.add_argument("--y-log", action="store_true", help="log-spaced y axis (needs 0 < LO)")
-    add_out(s, help=None)
+    add_out(s)
     add_quiet(s)
     s.set_defaults(run=run)
 

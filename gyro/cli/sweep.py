@@ -5,24 +5,23 @@ from __future__ import annotations
 import json
 import sys
 
-import numpy as np
-
-from gyro import ladder
-from gyro.cli.common import add_json, add_out, add_points, add_quiet, add_set, check_png_out, model_with_equilibrium, parse_sets
-from gyro.models import ParameterError
+from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_set, check_png_out,
+                             model_with_equilibrium, parse_sets)
+from gyro.errors import ParameterError
+from gyro.methods import names as method_names
 
 ORDER = 35
 
 
 def register(sub) -> None:
     s = sub.add_parser("sweep", help="natural frequencies against one parameter")
-    s.add_argument("model")
+    add_model(s)
     add_set(s)
     s.add_argument("--x", required=True, metavar="NAME", help="the parameter swept")
     s.add_argument("--x-range", nargs=2, type=float, required=True, metavar=("LO", "HI"))
     s.add_argument("--x-log", action="store_true", help="log-spaced (needs 0 < LO)")
     add_points(s, 50, "values of the parameter (default: 50)")
-    s.add_argument("--method", default="default", choices=ladder.METHODS, help="rung of the ladder")
+    s.add_argument("--method", default="default", choices=method_names(), help="rung of the ladder (default: %(default)s)")
     add_json(s)
     add_out(s, required=False, help="also plot the frequencies into FILE.png")
     add_quiet(s)
@@ -30,6 +29,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    import numpy as np
+
     from gyro.analyses.sweep import sweep
 
     model = model_with_equilibrium(args.model)

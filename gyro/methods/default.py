@@ -20,14 +20,13 @@ import numpy as np
 from gyro import qep
 from gyro.equilibrium import EquilibriumError, equilibria, operators, tame
 from gyro.kernels import chunks
-from gyro.methods import reference
+from gyro.methods import DEFAULT_TOL
 from gyro.models import Model
 from gyro.results import Spectrum
 
 NAME = "default"
 RUNG = 4
 COST = 3.6e-5  # s per set on one core, compiled (bench/results/ladder.json)
-DEFAULT_TOL = 1e-10
 CHUNK = 8192
 
 
@@ -70,6 +69,8 @@ def solve(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
         freq[k], growth[k], est[k] = np.abs(roots.imag), roots.real, e
     for k in np.flatnonzero(~good | (np.max(est, axis=1) > tol)):
         try:
+            from gyro.methods import reference  # the last rung, imported when reached
+
             ref = reference.solve(model, P[k:k + 1])
         except (EquilibriumError, ArithmeticError, ValueError, np.linalg.LinAlgError):
             # extended precision cannot answer either (a singular equilibrium problem, as at

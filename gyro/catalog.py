@@ -1,0 +1,26 @@
+"""Where the generated models are, and which there are, without importing them (or NumPy).
+
+The emitted models are the package gyro.generated: the repository's generated/ folder,
+mapped there by pyproject.toml (an editable install), or carried inside the wheel."""
+from __future__ import annotations
+
+import importlib.util
+from functools import lru_cache
+from pathlib import Path
+
+from gyro.errors import ParameterError
+
+GENERATED_PACKAGE = "gyro.generated"
+
+
+@lru_cache(maxsize=None)
+def generated_dir() -> Path:
+    spec = importlib.util.find_spec(GENERATED_PACKAGE)
+    if spec is None or not spec.submodule_search_locations:
+        raise ParameterError("no generated models installed (gyro.generated is missing): run `make derive`")
+    return Path(list(spec.submodule_search_locations)[0]).resolve()
+
+
+def available() -> list[str]:
+    """The generated models: folders of gyro.generated with a metadata.json."""
+    return sorted(p.name for p in generated_dir().iterdir() if (p / "metadata.json").exists())

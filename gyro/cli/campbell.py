@@ -1,12 +1,14 @@
 """`gyro campbell MODEL [--set NAME=VALUE]... --out FILE.png [--range LO HI] [--points N]`"""
 from __future__ import annotations
 
+import math
 import sys
 
 from gyro.cli.common import add_model, add_out, add_points, add_quiet, add_set, check_png_out, model_with_equilibrium, parse_sets
 from gyro.errors import ParameterError
 
 ORDER = 20
+MAX_POINTS = 100_000  # spins: the default method takes about 40 us each
 
 
 def register(sub) -> None:
@@ -27,10 +29,10 @@ def run(args) -> int:
     model = model_with_equilibrium(args.model)
     values = model.parameters(parse_sets(args.set))
     lo, hi = args.range
-    if not (0 < lo < hi):
-        raise ParameterError(f"--range: need 0 < LO < HI, got {lo} {hi}")
-    if args.points < 2:
-        raise ParameterError(f"--points: need at least 2, got {args.points}")
+    if not (0 < lo < hi) or not math.isfinite(hi) or not math.isfinite(hi * values.get("H", 1.0)):
+        raise ParameterError(f"--range: need finite 0 < LO < HI (H x HI finite), got {lo} {hi}")
+    if not 2 <= args.points <= MAX_POINTS:
+        raise ParameterError(f"--points: need 2..{MAX_POINTS}, got {args.points}")
     out = check_png_out(args.out)
     diagram = sweep(model, values, lo, hi, args.points, progress=not args.quiet and sys.stderr.isatty())
     diagram.plot(out)

@@ -30,8 +30,8 @@ def run(args) -> int:
     if args.method == "formulas" and "mode_formulas" not in model.meta["functions"]:
         raise ParameterError(f"--method formulas: {model.name} has no approximate formulas")
     spec = ladder.spectrum(model, model.vector(values), args.method)
-    if not np.all(np.isfinite(spec.frequencies[0])):
-        raise FloatingPointError("a frequency is not finite")
+    if not (np.all(np.isfinite(spec.frequencies[0])) and np.all(np.isfinite(spec.growth[0]))):
+        raise FloatingPointError("a frequency is not finite")  # no verdict: exit 1, text and JSON alike
     if args.json:
         print(json.dumps(spec.to_dict(0, model, values), allow_nan=False))
     else:

@@ -2,12 +2,14 @@
 [--y-log] --out FILE.png`"""
 from __future__ import annotations
 
+import math
 import sys
 
 from gyro.cli.common import add_model, add_out, add_points, add_quiet, add_set, check_png_out, model_with_equilibrium, parse_sets
 from gyro.errors import ParameterError
 
 ORDER = 30
+MAX_POINTS = 1000  # per axis: a million sets, about a minute
 
 
 def register(sub) -> None:
@@ -37,14 +39,14 @@ def run(args) -> int:
                                       ("--y", args.y, args.y_range, args.y_log)):
         if name not in model.param_names:
             raise ParameterError(f"{axis} {name!r}: unknown parameter; known: {' '.join(model.param_names)}")
-        if not lo < hi:
-            raise ParameterError(f"{axis}-range: need LO < HI, got {lo} {hi}")
+        if not lo < hi or not (math.isfinite(lo) and math.isfinite(hi)):
+            raise ParameterError(f"{axis}-range: need finite LO < HI, got {lo} {hi}")
         if log and not lo > 0:
             raise ParameterError(f"{axis}-range: {axis}-log needs 0 < LO, got {lo}")
         for v in (lo, hi):
             model.parameters({name: v})  # validates the ends of the range
-    if args.points < 2:
-        raise ParameterError(f"--points: need at least 2, got {args.points}")
+    if not 2 <= args.points <= MAX_POINTS:
+        raise ParameterError(f"--points: need 2..{MAX_POINTS} per axis, got {args.points}")
     out = check_png_out(args.out)
     grid = stability_grid(model, values, args.x, args.x_range, args.y, args.y_range,
                           args.points, progress=not args.quiet and sys.stderr.isatty(), xlog=args.x_log, ylog=args.y_log)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import sys
 
 from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_set, check_png_out,
@@ -38,8 +39,8 @@ def run(args) -> int:
     if args.x not in model.param_names:
         raise ParameterError(f"--x {args.x!r}: unknown parameter; known: {' '.join(model.param_names)}")
     lo, hi = args.x_range
-    if not lo < hi:
-        raise ParameterError(f"--x-range: need LO < HI, got {lo} {hi}")
+    if not lo < hi or not (math.isfinite(lo) and math.isfinite(hi)):
+        raise ParameterError(f"--x-range: need finite LO < HI, got {lo} {hi}")
     if args.x_log and not lo > 0:
         raise ParameterError(f"--x-range: --x-log needs 0 < LO, got {lo}")
     for v in (lo, hi):

@@ -62,12 +62,27 @@ def solve(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
         hf = h[fine]
         freq[hf], est[hf] = w[fine], e[fine]
         herm[h[~fine]] = False
+    zero_root = np.zeros((N, n), bool)
     for k in np.flatnonzero(good & ~herm):
         route[k] = "general"
         roots, e = qep.general(M[k], D[k], K[k])
         e = e + qep.input_rounding(model, P[k], roots, lambda Pp: qep.general_at(model, Pp))
         freq[k], growth[k], est[k] = np.abs(roots.imag), roots.real, e
-    for k in np.flatnonzero(~good | (np.max(est, axis=1) > tol)):
+        # an exact zero root (omega1 without Earth rate, u2 = 0: a free azimuth). lambda = 0
+        # is a root exactly when K is singular; then the smallest root, if it is within tol
+        # of the spectrum's scale and the others are answered, is that zero: 0 with a
+        # relative error of 1 (marginal), cheaply, where the 40-digit rung would only
+        # confirm a number like 1e-36 after a second
+        lam = np.abs(roots)
+        j = int(np.argmin(lam))
+        others = np.arange(n) != j
+        if e[j] > tol and lam[j] <= tol * np.max(lam) and np.all(e[others] <= tol):
+            sv = np.linalg.svd(K[k], compute_uv=False)
+            if sv[-1] <= 1e3 * qep.EPS * sv[0]:
+                freq[k, j], growth[k, j], est[k, j] = 0.0, 0.0, 1.0
+                zero_root[k, j] = True
+                route[k] = "general, a zero root"
+    for k in np.flatnonzero(~good | (np.max(np.where(zero_root, 0.0, est), axis=1) > tol)):
         try:
             from gyro.methods import reference  # the last rung, imported when reached
 

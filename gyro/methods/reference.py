@@ -50,8 +50,11 @@ def _reference_roots(mf, p, start, idx):
         lam = lams[int(np.argmin(np.abs(lam_c - r)))]
         J = M * lam**2 + D * lam + K
         dJ = M * (2 * lam) + D
-        Jinv = mpmath.inverse(J)
-        step = 1 / sum(Jinv[c, i] * dJ[i, c] for c in range(n) for i in range(n))
+        try:
+            Jinv = mpmath.inverse(J)
+            step = 1 / sum(Jinv[c, i] * dJ[i, c] for c in range(n) for i in range(n))
+        except ZeroDivisionError:  # J singular in the working precision: lam is a root to it
+            step = mpmath.mpf(0)
         lam = lam - step
         roots.append(lam)
         steps.append(abs(step) / abs(lam) if lam != 0 else mpmath.inf)

@@ -14,6 +14,7 @@ import os
 import platform
 import shutil
 import subprocess
+import sys
 import tempfile
 from contextlib import contextmanager
 from functools import lru_cache
@@ -73,6 +74,41 @@ def library(model_name: str) -> ctypes.CDLL:
     return _library(str(load(model_name).directory), model_name)
 
 
+def _writable_cache() -> Path:
+    """The cache folder, or, where it cannot be written (read-only, not creatable), a
+    private temporary folder for this process, said once on stderr."""
+    global _FALLBACK
+    d = cache_dir()
+    try:
+        d.mkdir(parents=True, exist_ok=True)
+        if os.access(d, os.W_OK | os.X_OK):
+            return d
+    except OSError:
+        pass
+    if _FALLBACK is None:
+        _FALLBACK = Path(tempfile.mkdtemp(prefix="gyro-cache-"))
+        print(f"gyro: the cache {d} cannot be written; compiling into {_FALLBACK} for this run",
+              file=sys.stderr)
+    return _FALLBACK
+
+
+_FALLBACK: Path | None = None
+
+
+def _digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _intact(so: Path) -> bool:
+    """A cached library is loaded only when its bytes are those it was written with (its
+    .sha256 beside it): a truncated or overwritten file is rebuilt, never loaded."""
+    seal = so.with_suffix(".sha256")
+    try:
+        return so.is_file() and seal.read_text().strip() == _digest(so)
+    except OSError:
+        return False
+
+
 @lru_cache(maxsize=None)
 def _library(directory: str, model_name: str) -> ctypes.CDLL:
     src = Path(directory) / f"{model_name}.c"
@@ -82,20 +118,37 @@ def _library(directory: str, model_name: str) -> ctypes.CDLL:
         raise CompilerUnavailable(f"no C compiler {cc!r} on PATH")
     key = hashlib.sha256(src.read_bytes() + hdr.read_bytes()
                          + " ".join((cc,) + FLAGS + (platform.machine(),)).encode()).hexdigest()[:16]
-    out = cache_dir() / f"{model_name}-{key}.so"
     if key in _FAILED:
         raise _FAILED[key]
-    if not out.exists():
-        out.parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryDirectory(dir=out.parent) as tmp:
-            tmp_so = Path(tmp) / out.name
-            proc = subprocess.run([cc, *FLAGS, "-I", str(src.parent), str(src), "-o", str(tmp_so), "-lm"],
-                                  capture_output=True, text=True)
-            if proc.returncode != 0:  # remembered: one failed build per process, not one per call
-                _FAILED[key] = CompilerUnavailable(f"{cc} failed on {src.name}: {proc.stderr.strip()[:500]}")
-                raise _FAILED[key]
-            os.replace(tmp_so, out)  # atomic: concurrent builders never see half a file
-    return ctypes.CDLL(str(out))
+    name = f"{model_name}-{key}.so"
+    out = cache_dir() / name
+    if not _intact(out):  # missing, truncated or overwritten: built again (where writable)
+        out = _writable_cache() / name
+        if not _intact(out):
+            _build(cc, src, out, key)
+    try:
+        return ctypes.CDLL(str(out))
+    except OSError as exc:  # sealed but unloadable: remembered, and the NumPy paths answer
+        _FAILED[key] = CompilerUnavailable(f"cannot load {out}: {exc}")
+        raise _FAILED[key] from None
+
+
+def _build(cc: str, src: Path, out: Path, key: str) -> None:
+    """Compile src into out (atomically, with its seal), saying so on stderr: the first run
+    on a machine takes some seconds here."""
+    print(f"gyro: compiling the generated C of {src.stem} once for this machine (into {out.parent}) ...",
+          file=sys.stderr, flush=True)
+    with tempfile.TemporaryDirectory(dir=out.parent) as tmp:
+        tmp_so = Path(tmp) / out.name
+        proc = subprocess.run([cc, *FLAGS, "-I", str(src.parent), str(src), "-o", str(tmp_so), "-lm"],
+                              capture_output=True, text=True)
+        if proc.returncode != 0:  # remembered: one failed build per process, not one per call
+            _FAILED[key] = CompilerUnavailable(f"{cc} failed on {src.name}: {proc.stderr.strip()[:500]}")
+            raise _FAILED[key]
+        seal = Path(tmp) / "seal"
+        seal.write_text(_digest(tmp_so) + "\n")
+        os.replace(tmp_so, out)  # atomic: concurrent builders never see half a file
+        os.replace(seal, out.with_suffix(".sha256"))
 
 
 class BatchFunction:

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 
@@ -34,7 +33,8 @@ def _save_npz(obj, path) -> None:
         else:
             data[f.name] = np.array(json.dumps(_jsonable(v)))
     path = Path(path)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    _clean_stale(path)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}{TMP_TAG}")
     try:
         with open(tmp, "wb") as fh:
             np.savez(fh, **data)
@@ -64,21 +64,33 @@ def _jsonable(v):
     return v
 
 
+TMP_TAG = ".gyro-tmp"  # temporaries beside an output: .<name>.<pid>.gyro-tmp<suffix>
+
+
+def _clean_stale(out: Path) -> None:
+    """Remove temporaries that a killed run left beside `out` (their process is gone)."""
+    for tmp in out.parent.glob(f".{out.name}.*{TMP_TAG}*"):
+        try:
+            pid = int(tmp.name[len(out.name) + 2:].split(".", 1)[0])
+            os.kill(pid, 0)  # alive: a concurrent run's, left alone
+        except (ValueError, ProcessLookupError):
+            tmp.unlink(missing_ok=True)
+        except PermissionError:
+            pass
+
+
 def save_figure(fig, out) -> None:
     """A figure written atomically: a temporary file in the same folder, renamed. A failed
-    run leaves nothing half-written, and the file gets an ordinary new file's mode."""
+    run leaves nothing half-written; a killed one leaves a temporary named after the output
+    and its process, which the next run that writes the same output removes."""
     out = Path(out)
-    fd, tmp = tempfile.mkstemp(suffix=out.suffix or ".png", dir=out.resolve().parent)
-    os.close(fd)
+    _clean_stale(out)
+    tmp = out.with_name(f".{out.name}.{os.getpid()}{TMP_TAG}{out.suffix or '.png'}")
     try:
         fig.savefig(tmp, dpi=130)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # as an ordinary new file (mkstemp makes it private)
         os.replace(tmp, out)
     finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+        tmp.unlink(missing_ok=True)
 
 
 def _pyplot():
@@ -139,9 +151,14 @@ class Spectrum:
                  f"natural frequencies by the method '{self.method}'"
                  + (f" (answered by its {self.route[k]} rung)" if self.route is not None else "") + ":",
                  f"{'':>4} {'omega [rad/s]':>16} {'f [Hz]':>14} {'period [s]':>14} {'rel. error <=':>14}"]
+        lam = np.abs(self.growth[k] + 1j * freqs)
+        grows = (self.growth[k] > np.maximum(np.where(np.isfinite(est), est, np.inf), 1e-9) * lam) & np.isfinite(est)
         for i, (w, e) in enumerate(zip(freqs, est), 1):
             period = 2 * np.pi / w if w > 0 else float("inf")
-            lines.append(f"{i:>4} {w:>16.9g} {w / (2 * np.pi):>14.6g} {period:>14.6g} {e:>14.2g}")
+            row = f"{i:>4} {w:>16.9g} {w / (2 * np.pi):>14.6g} {period:>14.6g} {e:>14.2g}"
+            if grows[i - 1]:
+                row += f"   grows at {self.growth[k][i - 1]:.6g} 1/s"
+            lines.append(row)
         label = stab.label[k]
         note = {"unstable": f", {stab.unstable_roots[k]} growing root(s), the fastest at {stab.growth_rate[k]:.6g} 1/s",
                 "unknown": " (a root's error is unbounded: this method cannot tell; try --method default)",

@@ -334,6 +334,9 @@ class ClosedForm:
         if not math.isfinite(self.omega):
             return np.zeros_like(tau), tau
         k = np.floor(tau / (2 * self.omega))
+        if np.any(np.abs(k) > 2.0**52):  # past 4.5e15 periods no digit of the phase is left
+            raise ArithmeticError(f"t reaches {np.max(np.abs(k)):.3g} periods of theta: the phase "
+                                  "within a period has no digit left in double precision")
         return k, tau - k * (2 * self.omega)
 
     def theta_tau(self, tau):
@@ -506,9 +509,22 @@ def _casadi_ode(P: np.ndarray):
     return y, ca.vertcat(qd, ca.solve(Mq, f))
 
 
-def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, atol: float = 1e-12):
+class IntegrationBudget(RuntimeError):
+    """An integrator stopped by its budget (a runaway on stiff or extreme input)."""
+
+
+BUDGET_SECONDS = 25.0  # an integrator's wall time at the most (a command stays under 30 s)
+BUDGET_STEPS = 2 * 10**6  # and its steps (right-hand sides for SciPy, internal steps for CasADi)
+
+
+def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, atol: float = 1e-12,
+              budget_s: float = BUDGET_SECONDS, budget_steps: int = BUDGET_STEPS):
     """Integrate the generated equations (1.1) (any C0) in psi, theta, phi from the motion's
-    initial state; returns (q, qd) at the times t (arrays len(t) x 3)."""
+    initial state; returns (q, qd) at the times t (arrays len(t) x 3). A run that needs
+    more than `budget_s` seconds or `budget_steps` steps stops with IntegrationBudget,
+    saying how far it got."""
+    import time
+
     t = np.asarray(t, float)
     P = param_vector(motion.params)
     y0 = np.concatenate([motion.q0, motion.qd0])
@@ -517,7 +533,13 @@ def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, at
 
         nf = load(MODEL).numpy
 
-        def rhs(_, y):
+        start, calls = time.perf_counter(), [0]
+
+        def rhs(tt, y):
+            calls[0] += 1
+            if calls[0] % 1000 == 0 and (calls[0] > budget_steps or time.perf_counter() - start > budget_s):
+                raise IntegrationBudget(f"{method} stopped at t = {tt:.6g} s of {t[-1]:.6g} s after "
+                                        f"{calls[0]} evaluations, {time.perf_counter() - start:.0f} s (its budget)")
             return np.concatenate([y[3:], np.linalg.solve(nf.mass_matrix(P, y[:3]), nf.forcing(P, y[:3], y[3:]))])
 
         sol = solve_ivp(rhs, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol)
@@ -528,9 +550,13 @@ def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, at
         import casadi as ca
 
         y, ydot = _casadi_ode(P)
-        opts = {"abstol": atol, "reltol": rtol, "max_num_steps": 10**8}
+        opts = {"abstol": atol, "reltol": rtol, "max_num_steps": budget_steps}
         F = ca.integrator("F", method, {"x": y, "ode": ydot}, t[0], t, opts)
-        Y = np.array(F(x0=y0)["xf"]).T
+        try:
+            Y = np.array(F(x0=y0)["xf"]).T
+        except RuntimeError as exc:  # SUNDIALS gives up (its step budget, or a failed step)
+            why = "its step budget" if "MXSTEP" in str(exc) or "mxstep" in str(exc).lower() else "a failed step"
+            raise IntegrationBudget(f"{method} stopped before t = {t[-1]:.6g} s ({why})") from None
     else:
         raise ParameterError(f"unknown method {method!r}; known: {' '.join(METHODS)}")
     return Y[:, :3], Y[:, 3:]

@@ -54,25 +54,83 @@ def build_parser() -> Parser:
 
 
 def main(argv=None) -> int:
-    args = build_parser().parse_args(argv)
+    try:
+        args = build_parser().parse_args(argv)
+    except KeyboardInterrupt:
+        return _interrupted()
     import numpy as np  # after parsing: `gyro --help` and usage errors import no NumPy
 
     from gyro.equilibrium import EquilibriumError
 
     try:
-        with np.errstate(all="ignore"):  # failures are caught below, one line each
+        with np.errstate(all="ignore"), _stdout_for_results_only():  # failures: one line each
             return args.run(args)
+    except KeyboardInterrupt:
+        return _interrupted()
     except ParameterError as exc:
         print(f"gyro: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
     except EquilibriumError as exc:
         print(f"gyro: error: no equilibrium found: {exc}", file=sys.stderr)
         return 1
-    except (np.linalg.LinAlgError, ArithmeticError, ValueError) as exc:
-        # valid input whose numbers the double-precision solvers cannot handle (e.g. 1e300)
+    except (np.linalg.LinAlgError, ArithmeticError, ValueError, RuntimeError) as exc:
+        # valid input whose numbers the solvers cannot handle (e.g. 1e300), an integrator
+        # that gives up, mpmath without convergence
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         print(f"gyro: error: numerical failure at these parameters ({msg})", file=sys.stderr)
         return 1
     except BrokenPipeError:  # output closed early (e.g. piped into head)
         sys.stderr.close()
         return 0
+    except MemoryError:
+        print("gyro: error: out of memory: fewer points or sets", file=sys.stderr)
+        return 1
+    except OSError as exc:  # writing a result (disk full, a folder gone meanwhile)
+        print(f"gyro: error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": "), file=sys.stderr)
+        return 1
+    except Exception as exc:  # a numerical library's own failure (mpmath's NoConvergence, ...)
+        if type(exc).__module__.split(".")[0] in ("mpmath", "scipy", "casadi", "numpy"):
+            msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            print(f"gyro: error: numerical failure at these parameters ({msg})", file=sys.stderr)
+            return 1
+        raise
+
+
+def _interrupted() -> int:
+    print("gyro: interrupted", file=sys.stderr)
+    return 130
+
+
+class _stdout_for_results_only:
+    """While a command runs, whatever C or Fortran code writes to file descriptor 1 (LAPACK's
+    `** On entry to DLASCL ...`) goes to stderr; Python's prints still reach the real
+    stdout, so that stdout carries the result alone (one JSON object with --json). Only
+    where sys.stdout is the process's own descriptor 1 (not under a capture)."""
+
+    def __enter__(self):
+        import os
+
+        self.saved = None
+        try:
+            if sys.stdout.fileno() != 1:
+                return self
+        except (AttributeError, ValueError, OSError):
+            return self
+        sys.stdout.flush()
+        self.saved = os.dup(1)
+        self.stdout = sys.stdout
+        os.dup2(2, 1)
+        sys.stdout = open(self.saved, "w", closefd=False, encoding=self.stdout.encoding, errors="replace")
+        return self
+
+    def __exit__(self, *exc):
+        import os
+
+        if self.saved is not None:
+            try:
+                sys.stdout.flush()
+            finally:
+                sys.stdout = self.stdout
+                os.dup2(self.saved, 1)
+                os.close(self.saved)
+        return False

@@ -82,6 +82,10 @@ def check_png_out(path) -> Path:
     out = Path(path)
     if out.suffix.lower() != ".png":
         raise ParameterError(f"--out {path!r}: the figure is written as PNG; name it *.png")
+    if out.is_dir():
+        raise ParameterError(f"--out {path!r}: is a folder; name the file")
+    if len(out.name.encode()) > 200:  # the temporary beside it adds its own tag to the name
+        raise ParameterError(f"--out: the file name is too long ({len(out.name.encode())} bytes; at most 200)")
     parent = out.resolve().parent
     if not parent.is_dir():
         raise ParameterError(f"--out {path!r}: folder {parent} does not exist")

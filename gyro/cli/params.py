@@ -19,4 +19,10 @@ def run(args) -> int:
     print(f"{'name':<8} {'default':>14} {'unit':<10} description")
     for p in model.params:
         print(f"{p.name:<8} {p.default:>14.8g} {p.unit:<10} {p.description}")
+    if model.name == "gimbal_gyroscope":  # a motion's initial conditions, for gyro simulate
+        from gyro.analyses.gimbal import INITIAL
+
+        print("initial conditions (gyro simulate; psi(0) = phi(0) = 0):")
+        for name, (unit, default, description) in INITIAL.items():
+            print(f"{name:<8} {default:>14.8g} {unit:<10} {description}")
     return 0

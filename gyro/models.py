@@ -94,11 +94,17 @@ class Model:
             values[key] = value
         return values
 
-    def vector(self, values: dict[str, float]) -> np.ndarray:
-        return np.array([values[n] for n in self.param_names], dtype=float)
+    def vector(self, values: dict[str, float] | None = None) -> np.ndarray:
+        """The parameter vector, in the order of param_names: the given values, validated,
+        and the paper example's for the others; an unknown name is a ParameterError
+        naming it."""
+        v = self.parameters(values) if set(values or {}) - set(self.defaults) or any(
+            not isinstance(x, (int, float)) for x in (values or {}).values()) else {**self.defaults, **(values or {})}
+        return np.array([v[n] for n in self.param_names], dtype=float)
 
     def vectors(self, batch: list[dict]) -> np.ndarray:
-        return np.array([[v[n] for n in self.param_names] for v in batch], dtype=float)
+        """Parameter vectors of several sets (rows), each completed as `vector` does."""
+        return np.array([self.vector(v) for v in batch], dtype=float)
 
 
 def _import_directory(directory: Path) -> str:

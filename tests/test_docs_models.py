@@ -123,7 +123,7 @@ class Recorder(doctest.DocTestRunner):
         sys.stderr.write(f"unexpected exception in: {example.source}{self.got[id(example)]}")
 
 
-def python_test(text: str) -> doctest.DocTest:
+def python_test(text: str, doc: Path = DOC) -> doctest.DocTest:
     """The page's pycon blocks as one doctest, with the page's line numbers."""
     examples = []
     for m in FENCE.finditer(text):
@@ -132,16 +132,16 @@ def python_test(text: str) -> doctest.DocTest:
             for ex in doctest.DocTestParser().get_examples(m.group(2)):
                 ex.lineno += start
                 examples.append(ex)
-    return doctest.DocTest(examples, {"__name__": "__main__"}, "docs/models.md", str(DOC), 0, None)
+    return doctest.DocTest(examples, {"__name__": "__main__"}, doc.relative_to(ROOT).as_posix(), str(doc), 0, None)
 
 
-def run_python(text: str) -> tuple[int, str]:
+def run_python(text: str, doc: Path = DOC) -> tuple[int, str]:
     """Run the page's Python session here (in a fresh process); (failures, report)."""
     import io
 
     out = io.StringIO()
     runner = doctest.DocTestRunner(checker=Checker(), optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
-    runner.run(python_test(text), out=out.write)
+    runner.run(python_test(text, doc), out=out.write)
     return runner.failures, out.getvalue()
 
 
@@ -188,11 +188,11 @@ def test_guide_runs_as_written(tmp_path):
 # --------------------------------------------------------------------------- as a script
 
 
-def fill() -> None:
+def fill(doc: Path = DOC) -> None:
     """Rewrite the expected outputs of the page's Python session with what it prints now
     (run into /tmp/pendulum after the shell blocks were run by hand)."""
-    text = DOC.read_text()
-    test = python_test(text)
+    text = doc.read_text()
+    test = python_test(text, doc)
     rec = Recorder()
     rec.run(test, clear_globs=False)
     examples = iter(test.examples)
@@ -212,16 +212,19 @@ def fill() -> None:
                 lines.append(rec.got[id(ex)].rstrip("\n"))
         pieces += [text[last:m.start(2)], "\n".join(lines) + "\n"]
         last = m.end(2)
-    DOC.write_text("".join(pieces) + text[last:])
+    doc.write_text("".join(pieces) + text[last:])
 
 
 if __name__ == "__main__":
     if sys.argv[1:2] == ["--run"]:
         sys.path[0] = str(ROOT)  # as a session started in the repository root
-        failures, report = run_python(page(sys.argv[2]))
+        doc = Path(sys.argv[3]) if len(sys.argv) > 3 else DOC
+        text = doc.read_text().replace(PLACEHOLDER, sys.argv[2]) if doc == DOC else doc.read_text()
+        failures, report = run_python(text, doc)
         print(report)
         sys.exit(1 if failures else 0)
-    elif sys.argv[1:] == ["--fill"]:
-        fill()
+    elif sys.argv[1:2] == ["--fill"]:
+        sys.path[0] = str(ROOT)
+        fill(Path(sys.argv[2]) if len(sys.argv) > 2 else DOC)
     else:
-        sys.exit("usage: test_docs_models.py --run FOLDER | --fill")
+        sys.exit("usage: test_docs_models.py --run FOLDER [PAGE] | --fill [PAGE]")

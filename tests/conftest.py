@@ -17,13 +17,13 @@ MODEL = "torsion_gyrocompass"
 # `pytest -m unit` (make test-unit) runs the fast tier alone; `make test` runs them all.
 TIERS = {
     "unit": ("test_mechanics", "test_machinery", "test_architecture", "test_results"),
-    "generated": ("test_generated", "test_textbook", "test_docs_models", "test_derivation"),
+    "generated": ("test_generated", "test_textbook", "test_docs_models", "test_derivation", "test_docs_api"),
     "paper": ("test_paper", "test_anchors", "test_nonlinear", "test_gimbal", "test_gimbal_closed_form",
               "test_gimbal_section6", "test_gimbal_paper_items", "test_paper_items",
               "test_gyrohorizoncompass"),
     "methods": ("test_ladder",),
     "properties": ("test_properties",),
-    "cli": ("test_cli", "test_gimbal_simulate", "test_readme", "test_sweep", "test_wheel"),
+    "cli": ("test_cli", "test_gimbal_simulate", "test_readme", "test_sweep", "test_wheel", "test_ghc_cli", "test_fuzz"),
 }
 _TIER_OF = {f: tier for tier, files in TIERS.items() for f in files}
 

@@ -156,12 +156,24 @@ def chart(out: dict) -> None:
     for ax, (name, entry) in zip(axes.ravel(), out["spreads"].items()):
         for m, (color, marker) in style.items():
             t = out["seconds_per_set"][m]
-            errs = np.maximum(np.nan_to_num(entry["methods"][m]["max_rel_error_per_frequency"], nan=10.0), floor)
-            errs = np.minimum(errs, 10.0)
+            raw = np.nan_to_num(np.asarray(entry["methods"][m]["max_rel_error_per_frequency"], float), nan=np.inf)
+            errs = np.clip(raw, floor, 10.0)
+            clipped = (raw < floor) | (raw > 10.0)  # drawn at the edge, marked: the value lies beyond
             jitter = t * np.exp(np.linspace(-0.12, 0.12, len(errs)))
             hollow = m in NUMPY_PATH  # the same algorithm without the generated C
-            ax.scatter(jitter, errs, marker=marker, s=22, alpha=0.8, label=m if ax is axes[0, 0] else None,
+            ax.scatter(jitter[~clipped], errs[~clipped], marker=marker, s=22, alpha=0.8,
+                       label=m if ax is axes[0, 0] else None,
                        facecolors="none" if hollow else color, edgecolors=color)
+            for side, sel in (("low", raw < floor), ("high", raw > 10.0)):
+                if not sel.any():
+                    continue
+                ax.scatter(jitter[sel], errs[sel], marker="v" if side == "low" else "^", s=40, color=color,
+                           alpha=0.9, facecolors="none" if hollow else color)
+                r_ = raw[sel].min() if side == "low" else raw[sel].max()
+                text = (f"down to {r_:.0e}" if side == "low" else
+                        (f"up to {r_:.0e}" if np.isfinite(r_) else "roots lost"))
+                ax.annotate(text, (jitter[sel][-1], errs[sel][-1]), fontsize=6, color=color,
+                            xytext=(4, 4 if side == "low" else -9), textcoords="offset points")
             ax.annotate("omega1", (jitter[0], errs[0]), fontsize=6, color=color,
                         xytext=(3, 3), textcoords="offset points")
         ax.axhline(1e-10, color="k", lw=0.7, ls="--")
@@ -178,8 +190,9 @@ def chart(out: dict) -> None:
     for ax in axes[:, 0]:
         ax.set_ylabel("max relative error against the reference")
     fig.legend(fontsize=8, loc="outside lower center", ncol=7)
-    fig.suptitle("Natural frequencies of the torsion gyrocompass: accuracy against speed "
-                 "(a point per method and frequency; dashed: 1e-10, dotted: speed goals)", fontsize=10)
+    fig.suptitle("Natural frequencies of the torsion gyrocompass: accuracy against speed (a point per "
+                 "method and frequency; dashed: 1e-10, dotted: speed goals;\nerrors below 1e-17 or above 10 "
+                 "drawn at the edge as a triangle pointing beyond, with their value)", fontsize=10)
     fig.savefig(RESULTS / "ladder_accuracy_speed.png", dpi=120)
     plt.close(fig)
 

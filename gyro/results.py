@@ -273,6 +273,7 @@ class CampbellDiagram:
     formulas: Spectrum | None
     values: dict  # the set the sweep scales
     Omega_example: float  # the paper example's spin, marked
+    changed: dict = field(default_factory=dict)  # the parameters that differ from the defaults
 
     @property
     def formula_error(self) -> np.ndarray | None:
@@ -294,12 +295,20 @@ class CampbellDiagram:
                 + ")")
 
     def plot(self, out) -> None:
+        """Frequencies against spin (modes numbered at the right), the formulas dashed; below,
+        each formula's relative error against spin on a log scale with the 1 % line."""
         plt = _pyplot()
         W = self.Omega
-        fig, ax = plt.subplots(figsize=(8, 6), layout="constrained")
+        panels = 2 if self.formulas is not None else 1
+        fig, axes = plt.subplots(panels, 1, figsize=(8, 9 if panels == 2 else 6), sharex=True,
+                                 layout="constrained", height_ratios=[3, 2][:panels], squeeze=False)
+        ax = axes[0, 0]
         ex = self.exact.frequencies
         for j in range(ex.shape[1]):
             ax.loglog(W, ex[:, j], color="k", lw=1.4, label="exact operator (default method)" if j == 0 else None)
+            if np.isfinite(ex[-1, j]):
+                ax.annotate(f"{j + 1}", (W[-1], ex[-1, j]), xytext=(3, 0), textcoords="offset points",
+                            fontsize=7, va="center")
         if self.formulas is not None:
             fo, err = self.formulas.frequencies, self.formula_error
             with np.errstate(all="ignore"):
@@ -308,14 +317,27 @@ class CampbellDiagram:
                 ax.loglog(W, fo[:, j], color="tab:blue", lw=1.0, ls="--",
                           label="formulas (3.2)-(3.28)" if j == 0 else None)
                 bad = ~(err[:, j] <= FORMULA_BAD)
-                # the band between a formula and the exact curve it approximates, where it errs > 1 %
                 ax.fill_between(W, np.where(np.isfinite(fo[:, j]), fo[:, j], near[:, j]), near[:, j],
                                 where=bad, color="tab:red", alpha=0.35, lw=0)
+            ax.fill_between([], [], color="tab:red", alpha=0.35, label="a formula errs by more than 1%")
+            eax = axes[1, 0]
+            colors = plt.get_cmap("tab10")
+            with np.errstate(all="ignore"):
+                shown = np.where(err > 0, err, np.nan)
+            for j in range(err.shape[1]):
+                eax.loglog(W, shown[:, j], color=colors(j % 10), lw=1.1, label=f"formula for mode {j + 1}")
+            eax.axhline(FORMULA_BAD, color="tab:red", lw=0.9, ls="--", label="1 %")
+            eax.set_ylabel("relative error of the formula")
+            eax.set_xlabel("spin Omega = H/A [rad/s]")
+            eax.grid(True, which="both", alpha=0.25)
+            eax.legend(fontsize=6.5, ncol=4, loc="best")
+            eax.axvline(self.Omega_example, color="0.5", lw=0.8, ls=":")
+        else:
+            ax.set_xlabel("spin Omega = H/A [rad/s]")
         ax.axvline(self.Omega_example, color="0.5", lw=0.8, ls=":", label="paper example")
-        ax.fill_between([], [], color="tab:red", alpha=0.35, label="a formula errs by more than 1% (band to the exact curve)")
-        ax.set_xlabel("spin Omega = H/A [rad/s]")
         ax.set_ylabel("natural frequency omega [rad/s]")
-        ax.set_title(f"Campbell diagram: {self.title}", fontsize=10)
+        changed = "" if not self.changed else "\n(" + ", ".join(f"{k} = {v:g}" for k, v in self.changed.items()) + ")"
+        ax.set_title(f"Campbell diagram: {self.title}{changed}", fontsize=10)
         ax.grid(True, which="both", alpha=0.25)
         ax.legend(fontsize=8, loc="upper left")
         save_figure(fig, out)
@@ -350,6 +372,7 @@ class StabilityMap:
     slowest: np.ndarray  # slowest growing rate, 1/s
     xlog: bool = False
     ylog: bool = False
+    changed: dict = field(default_factory=dict)  # parameters that differ from the defaults
 
     def __getitem__(self, key):  # the grid as a mapping, as sweeps and tests read it
         return getattr(self, key)
@@ -402,7 +425,9 @@ class StabilityMap:
                     continue
                 cs = ax.contour(self.x, self.y, np.log10(g), levels=levels, colors="k", linewidths=0.6,
                                 linestyles=style)
-                ax.clabel(cs, fmt=lambda v: f"{10**v:.2g}/s", fontsize=7)
+                # every other level labelled, spaced along the lines: labels that do not overlap
+                ax.clabel(cs, cs.levels[::2], fmt=lambda v: f"{10**v:.2g}/s", fontsize=6.5,
+                          inline_spacing=4, use_clabeltext=True)
         for xs, ys, label in lines:
             ax.plot(xs, ys, color="tab:blue", lw=1.2, ls=":", label=label)
         for code_, (name, color) in enumerate(zip(names, colors)):
@@ -414,8 +439,9 @@ class StabilityMap:
         ax.set_ylim(self.y[0], self.y[-1])
         ax.set_xlabel(f"{self.xname} [{self.units[self.xname]}]")
         ax.set_ylabel(f"{self.yname} [{self.units[self.yname]}]")
+        changed = "" if not self.changed else "; " + ", ".join(f"{k} = {v:g}" for k, v in self.changed.items())
         ax.set_title(f"Stability of the equilibrium: {self.title}\n(contours: growth rate, "
-                     "solid the fastest, dashed the slowest growing root)", fontsize=9)
+                     f"solid the fastest, dashed the slowest growing root{changed})", fontsize=9)
         ax.legend(fontsize=8, loc="best")
         save_figure(fig, out)
         plt.close(fig)

@@ -31,4 +31,5 @@ def sweep(model: Model, values: dict, lo: float, hi: float, points: int, progres
     has_A = "A" in model.param_names
     Omega = P[:, iH] / P[:, model.param_names.index("A")] if has_A else P[:, iH]
     example = model.defaults["H"] / model.defaults["A"] if has_A else model.defaults["H"]
-    return CampbellDiagram(model.name, model.meta["title"], Omega, exact, approx, values, example)
+    changed = {k: v for k, v in values.items() if v != model.defaults[k]}
+    return CampbellDiagram(model.name, model.meta["title"], Omega, exact, approx, values, example, changed)

@@ -100,6 +100,8 @@ def main(argv=None) -> int:
     tmp.replace(path)
     print(f"written {path.relative_to(ROOT)}")
     subprocess.run([sys.executable, "-m", "bench.gimbal_integrators"], cwd=ROOT, check=True)
+    for module in ("bench.startup", "bench.runtime_ab"):
+        subprocess.run([sys.executable, "-m", module], cwd=ROOT, check=True)
     return 0
 
 

@@ -11,11 +11,8 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import os
-import platform
 import shutil
-import subprocess
 import sys
-import tempfile
 from contextlib import contextmanager
 from functools import lru_cache
 from pathlib import Path
@@ -86,6 +83,8 @@ def _writable_cache() -> Path:
     except OSError:
         pass
     if _FALLBACK is None:
+        import tempfile
+
         _FALLBACK = Path(tempfile.mkdtemp(prefix="gyro-cache-"))
         print(f"gyro: the cache {d} cannot be written; compiling into {_FALLBACK} for this run",
               file=sys.stderr)
@@ -117,7 +116,7 @@ def _library(directory: str, model_name: str) -> ctypes.CDLL:
     if shutil.which(cc) is None:
         raise CompilerUnavailable(f"no C compiler {cc!r} on PATH")
     key = hashlib.sha256(src.read_bytes() + hdr.read_bytes()
-                         + " ".join((cc,) + FLAGS + (platform.machine(),)).encode()).hexdigest()[:16]
+                         + " ".join((cc,) + FLAGS + (os.uname().machine,)).encode()).hexdigest()[:16]
     if key in _FAILED:
         raise _FAILED[key]
     name = f"{model_name}-{key}.so"
@@ -136,6 +135,9 @@ def _library(directory: str, model_name: str) -> ctypes.CDLL:
 def _build(cc: str, src: Path, out: Path, key: str) -> None:
     """Compile src into out (atomically, with its seal), saying so on stderr: the first run
     on a machine takes some seconds here."""
+    import subprocess
+    import tempfile
+
     print(f"gyro: compiling the generated C of {src.stem} once for this machine (into {out.parent}) ...",
           file=sys.stderr, flush=True)
     with tempfile.TemporaryDirectory(dir=out.parent) as tmp:

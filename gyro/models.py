@@ -65,7 +65,11 @@ class Model:
         self.params = [Param(p["name"], p["unit"], p["default"], p["description"], p["kind"],
                              tuple(p["bounds"])) for p in self.meta["parameters"]]
         self.param_names = [p.name for p in self.params]
-        self.numpy = importlib.import_module(f"{package}.numpy_functions")
+
+    @cached_property
+    def numpy(self):
+        """The generated NumPy functions (imported on first use: the compiled path needs none)."""
+        return importlib.import_module(f"{self.package}.numpy_functions")
 
     @cached_property
     def casadi(self):

@@ -75,6 +75,14 @@ def _screen(text: str) -> str:
 CASES = [s for b in console_blocks(README.read_text()) for s in sessions(b)]
 
 
+@pytest.mark.parametrize("k", range(len(re.findall(r"```python\n", README.read_text()))))
+def test_readme_python_examples_run(k, capsys):
+    """Each Python block of the README runs as written."""
+    block = re.findall(r"```python\n(.*?)```", README.read_text(), re.S)[k]
+    exec(compile(block, f"README.md[python {k}]", "exec"), {"__name__": "__main__"})
+    assert capsys.readouterr().out.strip()
+
+
 def test_the_readme_has_console_sessions():
     assert len(CASES) >= 8
 

@@ -6,6 +6,10 @@
     gyro stability-map MODEL --x NAME --x-range LO HI --y NAME --y-range LO HI [--x-log] [--y-log] --out FILE.png
     gyro params MODEL
     gyro simulate gimbal_gyroscope [--set NAME=VALUE]... --t-end T [--points N] [--method NAME] [--json] [--out FILE.png]
+    gyro sweep MODEL --x NAME --x-range LO HI [--x-log] [--points N] [--method NAME] [--json] [--out FILE.png]
+    gyro stability gyrohorizoncompass [--set NAME=VALUE]... [--orbit] [--json]
+    gyro simulate gyrohorizoncompass [--set ...] --t-end T [--points N] [--perturb D1,D2,D3,D4] [--method NAME] [--json]
+    gyro map gyrohorizoncompass --x NAME=LO:HI:N --y NAME=LO:HI:N --out FILE.png [--json]
 
 Bad input prints one line on stderr naming the parameter and exits with code 2; a
 numerical failure at valid input one line and exit 1.

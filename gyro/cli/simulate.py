@@ -2,6 +2,13 @@
 [--method NAME] [--json] [--out FILE.png]`: a motion of the gimbal gyroscope by the closed
 form (2.6) (default) or by integrating the generated equations (1.1).
 
+`gyro simulate gyrohorizoncompass [--set NAME=VALUE]... --t-end T [--points N] [--perturb
+D1,D2,D3,D4] [--method NAME] [--json] [--out FILE.png]`: a motion of the gyrohorizoncompass
+from its relative equilibrium (3.1), the angles alpha, beta, gamma, epsilon moved by D1..D4
+rad (at rest), by integrating the emitted (1.5)-(1.6) (default DOP853; `projected`: fixed
+steps of DOP853's tableau projected onto E = E(0)); E (2.3) along it. Parameters:
+A B C J L I nu zeta eta lambda (lambda defaults to 1 + chi).
+
 Parameters: the model's (`gyro params gimbal_gyroscope`) and the initial conditions
 theta0 dtheta0 dpsi0 dphi0 (rad, rad/s); psi(0) = phi(0) = 0. Every input is checked before
 anything is computed; bad input exits with 2 and one line naming it.
@@ -12,30 +19,34 @@ import json
 import math
 from pathlib import Path
 
-import numpy as np
-
 from gyro.cli.common import add_json, add_set, parse_sets
-from gyro.models import Param, ParameterError, load
+from gyro.errors import ParameterError
 
 ORDER = 50
-SIMULATED = ("gimbal_gyroscope",)
+MAX_POINTS = 10**6  # time points: 8 MB a coordinate
+SIMULATED = ("gimbal_gyroscope", "gyrohorizoncompass")
 
 
 def register(sub) -> None:
-    s = sub.add_parser("simulate", help="a motion of the gimbal gyroscope: closed form or integrator")
+    s = sub.add_parser("simulate", help="a motion of the gimbal gyroscope (closed form or integrator) "
+                       "or of the gyrohorizoncompass (integrator)")
     s.add_argument("model")
-    add_set(s, "parameter or initial condition (theta0 dtheta0 dpsi0 dphi0), SI units, radians")
+    add_set(s, "parameter or, for the gimbal, initial condition (theta0 dtheta0 dpsi0 dphi0), SI units, radians")
     s.add_argument("--t-end", required=True, metavar="T", help="end time in s (> 0)")
     s.add_argument("--points", default="1001", metavar="N", help="number of time points from 0 to T (>= 2)")
-    s.add_argument("--method", default="closed_form", metavar="NAME",
-                   help="closed_form (default), RK45, DOP853, Radau, BDF, LSODA, cvodes or idas")
+    s.add_argument("--method", default=None, metavar="NAME",
+                   help="closed_form (the gimbal's default), RK45, DOP853 (the gyrohorizoncompass's default), "
+                   "Radau, BDF, LSODA, cvodes, idas (gimbal) or cvodes-adams, projected (gyrohorizoncompass)")
+    s.add_argument("--perturb", default=None, metavar="D1,D2,D3,D4",
+                   help="gyrohorizoncompass: alpha, beta, gamma, epsilon - epsilon0 at t = 0, rad (default 0,0,0,0)")
     add_json(s)
-    s.add_argument("--out", metavar="FILE.png", help="also plot theta, psi, phi against t into FILE.png")
+    s.add_argument("--out", metavar="FILE.png", help="also plot the coordinates against t into FILE.png")
     s.set_defaults(run=run)
 
 
-def _initial_params() -> list[Param]:
+def _initial_params() -> list:
     from gyro.analyses.gimbal import INITIAL
+    from gyro.models import Param
 
     return [Param(n, u, d, desc, "real", (None, None)) for n, (u, d, desc) in INITIAL.items()]
 
@@ -52,10 +63,17 @@ def _number(name: str, raw: str) -> float:
 
 def parse(args):
     """(Motion, times, method) from the arguments, or ParameterError naming the input."""
+    import numpy as np
+
     from gyro.analyses.gimbal import METHODS, Motion
+    from gyro.models import load
 
     if args.model not in SIMULATED:
         raise ParameterError(f"simulate: unknown model {args.model!r}; it covers {', '.join(SIMULATED)}")
+    if args.perturb is not None:
+        raise ParameterError("--perturb: only for gyrohorizoncompass (the gimbal takes --set theta0=...)")
+    if args.method is None:
+        args.method = "closed_form"
     model = load(args.model)
     ic = {p.name: p for p in _initial_params()}
     sets = parse_sets(args.set)
@@ -79,8 +97,8 @@ def parse(args):
         points = int(args.points)
     except ValueError:
         raise ParameterError(f"--points: not an integer: {args.points!r}") from None
-    if points < 2:
-        raise ParameterError(f"--points must be at least 2, got {points}")
+    if not 2 <= points <= MAX_POINTS:
+        raise ParameterError(f"--points must lie in 2..{MAX_POINTS}, got {points}")
     if args.method not in METHODS:
         raise ParameterError(f"--method: unknown method {args.method!r}; known: {' '.join(METHODS)}")
     if args.out is not None:
@@ -93,9 +111,53 @@ def parse(args):
     return motion, np.linspace(0.0, t_end, points), args.method
 
 
+def _times(args):
+    import numpy as np
+
+    t_end = _number("--t-end", args.t_end)
+    if not t_end > 0:
+        raise ParameterError(f"--t-end must be positive, got {args.t_end!r}")
+    try:
+        points = int(args.points)
+    except ValueError:
+        raise ParameterError(f"--points: not an integer: {args.points!r}") from None
+    if not 2 <= points <= MAX_POINTS:
+        raise ParameterError(f"--points must lie in 2..{MAX_POINTS}, got {points}")
+    return np.linspace(0.0, t_end, points)
+
+
+def _run_ghc(args) -> int:
+    """gyrohorizoncompass: every input checked first (names, numbers, equilibrium, --perturb,
+    --t-end, --points, --method, --out), then integrated."""
+    from gyro.analyses import gyrohorizoncompass as ghc
+    from gyro.cli.common import check_png_out
+
+    values = ghc.parameters(parse_sets(args.set))
+    perturb = [0.0] * 4
+    if args.perturb is not None:
+        parts = args.perturb.split(",")
+        if len(parts) != 4:
+            raise ParameterError(f"--perturb: expected four numbers D1,D2,D3,D4, got {args.perturb!r}")
+        perturb = [_number(f"--perturb {n}", p) for n, p in zip(("alpha", "beta", "gamma", "epsilon"), parts)]
+    t = _times(args)
+    method = args.method or "DOP853"
+    if method not in ghc.METHODS:
+        raise ParameterError(f"--method: unknown method {method!r}; known: {' '.join(ghc.METHODS)}")
+    out = check_png_out(args.out) if args.out is not None else None
+    tr = ghc.trajectory(values, t, perturb, method)
+    if out is not None:
+        tr.plot(out)
+    print(json.dumps(tr.to_dict(), allow_nan=False) if args.json else tr.table())
+    return 0
+
+
 def run(args) -> int:
+    import numpy as np
+
     from gyro.analyses.gimbal import trajectory
 
+    if args.model == "gyrohorizoncompass":
+        return _run_ghc(args)
     motion, t, method = parse(args)
     tr = trajectory(motion, t, method)
     if not (np.all(np.isfinite(tr.theta)) and np.all(np.isfinite(tr.psi)) and np.all(np.isfinite(tr.phi))):

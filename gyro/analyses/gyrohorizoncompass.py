@@ -1,0 +1,444 @@
+"""Gyrohorizoncompass in a Newtonian field (Zavozin 1979, seed 001): the relative equilibrium
+(3.1)-(3.2), the sufficient conditions (3.6) and (4.3) against the spectrum of the
+linearisation, maps of the three regions, and motions by integrating the emitted equations.
+
+Everything numerical comes from generated/gyrohorizoncompass/: the equilibrium epsilon0 and
+its existence margins (`relative_equilibrium`), B1 and C1 (`lyapunov`), the margins of the
+conditions (`stability_conditions`), the operator M, D, K (`operator`), E (`first_integral`),
+and the equations of motion (`mass_matrix`, `forcing`).
+
+The spectrum: the eigenvalues of the companion matrix [[0, I], [-M^-1 K, -M^-1 D]] of the
+emitted operator at (0, 0, 0, epsilon0) (LAPACK, balanced; gyro.qep.companion_matrix). The
+ladder's default method assumes gyroscopic blocks with K > 0, which fails exactly where this
+module looks (gyroscopic stabilisation, K indefinite), so the companion eigensolve is used
+throughout. Spectrally stable: no eigenvalue with real part above 1e-9 |eig|max.
+
+Names: the command line's `lambda` is the model's `lam` (a keyword of C and Python); its
+default is 1 + chi of the given A, B, C, I (3.2). `theta` = (C - A)/I and `chi` = (C - B)/I
+may be map axes: they move A and B with C and I fixed.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from gyro.equilibrium import operators
+from gyro.kernels import function
+from gyro.models import ParameterError, load
+from gyro.qep import companion_matrix
+
+MODEL = "gyrohorizoncompass"
+CLI_NAMES = {"lambda": "lam"}  # the model file's CLI_NAMES (command line -> model symbol)
+NAMES = ("A", "B", "C", "J", "L", "I", "nu", "zeta", "eta", "lambda")
+DERIVED = ("theta", "chi")  # map axes besides the parameters
+REL = 1e-9  # a real part above REL |eig|max grows
+LAMBDA_TOL = 1e-12  # lambda = 1 + chi to this relative tolerance when eta != 0
+
+C36 = ("(3.6) 1 + theta", "(3.6) 1/3 - theta", "(3.6) 1 + chi", "(3.6) 1/3 - chi",
+       "(3.6) (1 - 3 theta) nu^2 - zeta^2 - eta^2", "(3.6) (1 - 3 chi) nu^2 - eta^2")
+C43 = ("(4.3) lambda + theta - chi", "(4.3) lambda/4 - chi", "(4.3) -theta")
+SYLVESTER = ("C1 minor 1 (alpha)", "C1 minor 2 (alpha, gamma)", "C1 minor 3 (alpha, gamma, beta)",
+             "C1 minor 4 (all)")
+
+
+def model():
+    return load(MODEL)
+
+
+def cli_name(name: str) -> str:
+    return {v: k for k, v in CLI_NAMES.items()}.get(name, name)
+
+
+def _number(name: str, raw) -> float:
+    try:
+        value = float(raw)
+    except (TypeError, ValueError):
+        raise ParameterError(f"parameter {name}: not a number: {raw!r}") from None
+    if not math.isfinite(value):
+        raise ParameterError(f"parameter {name}: must be a finite number, got {raw!r}")
+    return value
+
+
+def _check(name: str, value: float) -> None:
+    """The model's own check of a parameter, its message naming the command-line name."""
+    by_name = {p.name: p for p in model().params}
+    replace(by_name[CLI_NAMES.get(name, name)], name=name).check(value)
+
+
+def parameters(sets: dict | None = None, orbit: bool = False, base: dict | None = None,
+               need_equilibrium: bool = True) -> dict:
+    """The model's values (keys A ... eta, lam) from command-line NAME=VALUE pairs (keys
+    A ... eta, lambda; values text or numbers), over `base` (model keys; default: the
+    defaults, the Earth set), with lambda = 1 + chi unless given and, with `orbit`,
+    zeta = nu, eta = 0 (4.1). Checked: names, numbers, signs, and that the relative
+    equilibrium exists (I lambda zeta/2L < 1; eta != 0 needs lambda = 1 + chi).
+    Raises ParameterError naming the parameter or the reason."""
+    sets = dict(sets or {})
+    values = dict(model().defaults if base is None else base)
+    given = set()
+    for key, raw in sets.items():
+        if key not in NAMES:
+            raise ParameterError(f"unknown parameter {key!r} for {MODEL}; known: {' '.join(NAMES)}")
+        v = _number(key, raw)
+        _check(key, v)
+        values[CLI_NAMES.get(key, key)] = v
+        given.add(key)
+    if orbit:
+        for key in ("zeta", "eta"):
+            if key in given:
+                raise ParameterError(f"parameter {key}: --orbit sets zeta = nu and eta = 0; do not --set {key}")
+        values["zeta"], values["eta"] = values["nu"], 0.0
+    if "lambda" not in given:
+        values["lam"] = 1.0 + (values["C"] - values["B"]) / values["I"]
+        if not values["lam"] > 0:
+            raise ParameterError(f"parameter lambda: its default 1 + chi = {values['lam']!r} is not positive "
+                                 "(chi = (C - B)/I <= -1); give B, C, I with chi > -1 or set lambda")
+    if need_equilibrium:
+        check_equilibrium(values)
+    return values
+
+
+def check_equilibrium(values: dict) -> None:
+    """ParameterError unless the relative equilibrium (3.1)-(3.2) exists at these values."""
+    ratio = values["I"] * values["lam"] * values["zeta"] / (2 * values["L"])
+    if not ratio < 1:
+        raise ParameterError(f"no equilibrium: I lambda zeta/2L = {ratio:.6g} >= 1 (3.1) "
+                             "(lower zeta, I or lambda, or raise L)")
+    one_chi = 1.0 + (values["C"] - values["B"]) / values["I"]
+    if values["eta"] != 0 and abs(values["lam"] - one_chi) > LAMBDA_TOL * max(1.0, abs(one_chi)):
+        raise ParameterError(f"no equilibrium: eta = {values['eta']!r} != 0 needs lambda = 1 + chi = "
+                             f"{one_chi!r} (3.2), got lambda = {values['lam']!r}")
+
+
+def with_axis(values: dict, name: str, value: float) -> dict:
+    """`values` with one axis set: a parameter (command-line name), or theta/chi, which move
+    A or B (C and I fixed)."""
+    v = dict(values)
+    if name == "theta":
+        v["A"] = v["C"] - value * v["I"]
+    elif name == "chi":
+        v["B"] = v["C"] - value * v["I"]
+    else:
+        v[CLI_NAMES.get(name, name)] = value
+    return v
+
+
+def cli_params(values: dict) -> dict:
+    return {cli_name(k): float(v) for k, v in values.items()}
+
+
+# ------------------------------------------------------------------ conditions and spectrum
+
+
+def on_orbit(values: dict) -> bool:
+    return values["zeta"] == values["nu"] and values["eta"] == 0
+
+
+def analyse(P: np.ndarray, orbit: np.ndarray | bool = False) -> dict:
+    """Batch P (sets, 10) of model vectors: epsilon0, theta, chi, the margins, `sufficient`,
+    the eigenvalues (sets, 8), `spectrally_stable`, B1, C1 and the residual at (3.1).
+
+    `sufficient`: C1 > 0 by the paper's own conditions: (4.3) on the orbit (`orbit`), (3.6)
+    where lambda = 1 + chi, and where lambda != 1 + chi (eta = 0 off the orbit, where the
+    printed rows are not C1's minors) the Sylvester minors of C1 they stand for."""
+    m = model()
+    P = np.atleast_2d(np.asarray(P, float))
+    n = P.shape[0]
+    with np.errstate(all="ignore"):
+        eps0, margins, tc = (np.asarray(x).reshape(n, -1) for x in function(m, "relative_equilibrium")(P))
+        syl, c36, c43 = (np.asarray(x).reshape(n, -1) for x in function(m, "stability_conditions")(P))
+        B1, C1 = (np.asarray(x).reshape(n, 4, 4) for x in function(m, "lyapunov")(P))
+        qe = np.zeros((n, 4))
+        qe[:, 3] = eps0[:, 0]
+        resid = np.asarray(function(m, "equilibrium_residual")(P, qe)[0]).reshape(n, -1)
+        M, D, K = operators(m, P, qe)
+        ok = np.isfinite(eps0[:, 0])
+        A = companion_matrix(np.where(ok[:, None, None], M, np.eye(4)), D, K)
+        eig = np.full((n, 8), np.nan + 0j)
+        eig[ok] = np.linalg.eigvals(A[ok])
+    lam = P[:, 9]
+    exact = np.abs(lam - (1 + tc[:, 1])) <= LAMBDA_TOL * np.maximum(1.0, np.abs(1 + tc[:, 1]))
+    orbit = np.broadcast_to(np.asarray(orbit, bool), (n,))
+    sufficient = np.where(orbit, np.all(c43 > 0, axis=1),
+                          np.where(exact, np.all(c36 > 0, axis=1), np.all(syl > 0, axis=1))) & ok
+    big = np.max(np.abs(eig), axis=1)
+    growth = np.max(eig.real, axis=1)
+    stable = ok & (growth <= REL * big)
+    return {"epsilon0": eps0[:, 0], "exists": margins[:, 0], "theta": tc[:, 0], "chi": tc[:, 1],
+            "lambda_is_1_chi": exact,
+            "sylvester": syl, "c36": c36, "c43": c43, "sufficient": sufficient, "eigenvalues": eig,
+            "spectrally_stable": stable, "growth": growth, "B1": B1, "C1": C1, "residual": resid}
+
+
+def stability(values: dict, orbit: bool = False):
+    """The relative equilibrium of one set, its conditions and its spectrum, as a
+    gyro.results.EquilibriumStability (the `gyro stability --json` document). Conditions:
+    the rows of (3.6) where lambda = 1 + chi (which they assume), the rows of (4.3) on the
+    orbit, and C1's Sylvester minors always."""
+    from gyro.results import EquilibriumStability
+
+    m = model()
+    a = analyse(m.vector(values)[None], orbit or on_orbit(values))
+    conditions = {}
+    if a["lambda_is_1_chi"][0]:  # the printed rows of (3.6) assume lambda = 1 + chi
+        conditions.update(zip(C36, map(float, a["c36"][0])))
+    if orbit or on_orbit(values):
+        conditions.update(zip(C43, map(float, a["c43"][0])))
+    conditions.update(zip(SYLVESTER, map(float, a["sylvester"][0])))
+    eig = a["eigenvalues"][0]
+    eig = eig[np.lexsort((eig.real, eig.imag))]
+    return EquilibriumStability(
+        model=MODEL, title=m.meta["title"], params=cli_params(values),
+        equilibrium={"alpha": 0.0, "beta": 0.0, "gamma": 0.0, "epsilon0": float(a["epsilon0"][0])},
+        theta=float(a["theta"][0]), chi=float(a["chi"][0]), conditions=conditions,
+        sufficient=bool(a["sufficient"][0]), orbit=bool(orbit),
+        eigenvalues=np.stack([eig.real, eig.imag], axis=1), spectrally_stable=bool(a["spectrally_stable"][0]))
+
+
+def frequencies(values: dict) -> np.ndarray:
+    """|eig| of the linearisation, one per mode, ascending (rad/s)."""
+    eig = analyse(model().vector(values)[None])["eigenvalues"][0]
+    return np.sort(np.abs(eig))[::2]
+
+
+def energy_bound(values: dict) -> float:
+    """sqrt(cond(diag(B1, C1))): where C1 > 0, V = const keeps |x(t)| below this times |x(0)|
+    (x = (q - qe, q'), to second order in x)."""
+    a = analyse(model().vector(values)[None])
+    w = np.concatenate([np.linalg.eigvalsh(a["B1"][0]), np.linalg.eigvalsh(a["C1"][0])])
+    return float(math.sqrt(w.max() / w.min())) if w.min() > 0 else math.inf
+
+
+# ------------------------------------------------------------------ maps
+
+
+def parse_axis(flag: str, text: str, m=None) -> tuple[str, float, float, int]:
+    """NAME=LO:HI:N -> (name, lo, hi, n), or ParameterError naming the flag."""
+    name, sep, rng = str(text).partition("=")
+    parts = rng.split(":")
+    if not sep or len(parts) != 3:
+        raise ParameterError(f"{flag} {text!r}: expected NAME=LO:HI:N")
+    name = name.strip()
+    if name not in NAMES + DERIVED:
+        raise ParameterError(f"{flag} {name!r}: unknown axis; known: {' '.join(NAMES + DERIVED)}")
+    lo, hi = (_number(f"{flag} {name}", p) for p in parts[:2])
+    try:
+        n = int(parts[2])
+    except ValueError:
+        raise ParameterError(f"{flag} {name}: N not an integer: {parts[2]!r}") from None
+    if not lo < hi:
+        raise ParameterError(f"{flag} {name}: need LO < HI, got {lo!r}:{hi!r}")
+    if not 2 <= n <= 1000:
+        raise ParameterError(f"{flag} {name}: N must lie in [2, 1000], got {n}")
+    return name, lo, hi, n
+
+
+def condition_map(base: dict, xaxis, yaxis, orbit: bool = False, lambda_follows: bool = True):
+    """The (3.6) region, the spectrally stable one and the unstable one over a grid of two
+    axes ((name, lo, hi, n) each: parameters or theta, chi), lambda following 1 + chi when
+    `lambda_follows` (and lambda is no axis). Values: 2 where the sufficient condition holds, 1 spectrally stable
+    outside it, 0 unstable. Every grid point is checked first (ParameterError naming the
+    axis value where a parameter is out of range or there is no equilibrium)."""
+    from gyro.results import ConditionMap
+
+    m = model()
+    (xn, xlo, xhi, nx), (yn, ylo, yhi, ny) = xaxis, yaxis
+    if xn == yn:
+        raise ParameterError(f"--x and --y are both {xn!r}")
+    x, y = np.linspace(xlo, xhi, nx), np.linspace(ylo, yhi, ny)
+    sets = []
+    for yv in y:
+        for xv in x:
+            v = with_axis(with_axis(base, xn, xv), yn, yv)
+            if orbit:
+                v["zeta"], v["eta"] = v["nu"], 0.0
+            if lambda_follows and "lambda" not in (xn, yn):
+                v["lam"] = 1.0 + (v["C"] - v["B"]) / v["I"]
+            where = f"at {xn} = {xv:.6g}, {yn} = {yv:.6g}"
+            for k, p in v.items():
+                try:
+                    _check(cli_name(k), p)
+                except ParameterError as exc:
+                    raise ParameterError(f"{exc} ({where})") from None
+            try:
+                check_equilibrium(v)
+            except ParameterError as exc:
+                raise ParameterError(f"{exc} ({where})") from None
+            sets.append(v)
+    a = analyse(m.vectors(sets), orbit)
+    values = np.where(a["sufficient"], 2, np.where(a["spectrally_stable"], 1, 0)).reshape(ny, nx)
+    growth = np.maximum(a["growth"], 0.0).reshape(ny, nx)
+    moved = {xn, yn} | {k for k, d in (("A", "theta"), ("B", "chi")) if d in (xn, yn)}
+    if lambda_follows:
+        moved.add("lambda")
+    if orbit:
+        moved |= {"zeta", "eta"}
+    return ConditionMap(model=MODEL, title=m.meta["title"], xname=xn, yname=yn, x=x, y=y,
+                        values=values.astype(int), growth=growth, orbit=bool(orbit),
+                        base={k: v for k, v in cli_params(base).items() if k not in moved})
+
+
+# ------------------------------------------------------------------ motions
+
+SCIPY_METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")
+CASADI_METHODS = ("cvodes", "cvodes-adams")  # cvodes: BDF (CasADi's default); cvodes-adams: Adams-Moulton
+PROJECTED = "projected"  # fixed-step DOP853 tableau, each step projected onto E = E(0)
+METHODS = (*SCIPY_METHODS, *CASADI_METHODS, PROJECTED)
+RTOL, ATOL = 1e-10, 1e-12  # the command line's tolerances
+STEPS_PER_RADIAN = 10.0  # `projected`: steps per radian of the fastest mode
+BUDGET_SECONDS = 25.0  # the command line's integrations: wall time at the most
+BUDGET_STEPS = 2 * 10**6  # and steps (right-hand sides for SciPy, steps per output for CasADi, fixed steps)
+CHUNK = 1000  # `projected`: fixed steps per compiled call
+
+
+class IntegrationBudget(RuntimeError):
+    """An integration stopped by its budget (a runaway on extreme input), saying how far it got."""
+
+
+def _casadi_rhs():
+    """y' = F(y, P), y = (q, q'), from the emitted CasADi mass matrix and forcing; and E(y, P)."""
+    import casadi as ca
+
+    cf = model().casadi
+    y, p = ca.SX.sym("y", 8), ca.SX.sym("p", 10)
+    ydot = ca.vertcat(y[4:], ca.solve(cf.mass_matrix(p, y[:4]), cf.forcing(p, y[:4], y[4:])))
+    E = cf.first_integral(p, y[:4], y[4:])[0]
+    return ca, y, p, ydot, E
+
+
+def projected_stepper(P: np.ndarray, h: float, n: int, iterations: int = 2):
+    """A CasADi function y -> the states after each of n fixed steps of length h: the
+    8th-order Dormand-Prince tableau (DOP853's), each step followed by the orthogonal
+    projection onto E = E0 (Newton along grad E; E0 an input): Hairer, Lubich and Wanner's
+    standard projection, an energy-preserving scheme."""
+    from scipy.integrate._ivp import dop853_coefficients as dc
+
+    ca, y, p, ydot, E = _casadi_rhs()
+    f = ca.Function("f", [y, p], [ydot])
+    Ef = ca.Function("E", [y, p], [E, ca.gradient(E, y)])
+    x, e0 = ca.SX.sym("x", 8), ca.SX.sym("e0")
+    k = []
+    for i in range(dc.N_STAGES):
+        k.append(f(x + h * sum((dc.A[i, j] * k[j] for j in range(i) if dc.A[i, j] != 0), ca.SX.zeros(8)), P))
+    z = x + h * sum(dc.B[i] * k[i] for i in range(dc.N_STAGES))
+    for _ in range(iterations):
+        e, g = Ef(z, P)
+        z = z - (e - e0) / ca.dot(g, g) * g
+    step = ca.Function("step", [x, e0], [z])
+    return step.mapaccum("steps", n)
+
+
+def integrate(values: dict, y0: np.ndarray, t: np.ndarray, method: str = "DOP853",
+              rtol: float = RTOL, atol: float = ATOL, steps_per_radian: float = STEPS_PER_RADIAN,
+              budget_s: float | None = None, budget_steps: int | None = None) -> np.ndarray:
+    """States (len(t), 8) = (q, q') from y0 at t[0] by one of METHODS; the equations are the
+    emitted (1.5)-(1.6). `projected` takes fixed steps of at most 1/(steps_per_radian
+    |eig|max) between the output times (which it needs evenly spaced). With a budget (the
+    command line's), a run that needs more seconds or steps stops with IntegrationBudget."""
+    import time
+
+    t = np.asarray(t, float)
+    P = model().vector(values)
+    y0 = np.asarray(y0, float)
+    start = time.perf_counter()
+    max_s = math.inf if budget_s is None else budget_s
+    max_steps = math.inf if budget_steps is None else budget_steps
+    if method in SCIPY_METHODS:
+        from scipy.integrate import solve_ivp
+
+        ca, y, p, ydot, _ = _casadi_rhs()
+        f = ca.Function("f", [y, p], [ydot])
+        jf = ca.Function("J", [y, p], [ca.jacobian(ydot, y)])
+        kw = {"jac": lambda _, Y: np.array(jf(Y, P))} if method in ("Radau", "BDF", "LSODA") else {}
+        calls = [0]
+
+        def rhs(tt, Y):
+            calls[0] += 1
+            if calls[0] % 1000 == 0 and (calls[0] > max_steps or time.perf_counter() - start > max_s):
+                raise IntegrationBudget(f"{method} stopped at t = {tt:.6g} s of {t[-1]:.6g} s after {calls[0]} "
+                                        f"evaluations, {time.perf_counter() - start:.0f} s (its budget)")
+            return np.array(f(Y, P)).ravel()
+
+        sol = solve_ivp(rhs, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol, **kw)
+        if not sol.success:
+            raise FloatingPointError(f"{method}: {sol.message}")
+        return sol.y.T
+    if method in CASADI_METHODS:
+        ca, y, p, ydot, _ = _casadi_rhs()
+        ode = ca.substitute(ydot, p, ca.DM(P))
+        per = max(500, max_steps // max(1, len(t) - 1))  # SUNDIALS counts steps between output times
+        opts = {"abstol": atol, "reltol": rtol, "max_num_steps": int(min(per, 10**9)),
+                "disable_internal_warnings": True}  # SUNDIALS' own lines on stderr: the error says it
+        if method == "cvodes-adams":  # non-stiff: Adams-Moulton with fixed-point iteration
+            opts.update(linear_multistep_method="adams", nonlinear_solver_iteration="functional")
+        F = ca.integrator("F", "cvodes", {"x": y, "ode": ode}, t[0], t[1:], opts)
+        try:
+            Y = np.array(F(x0=y0)["xf"]).T
+        except RuntimeError:  # SUNDIALS gives up (its step budget, or a failed step)
+            raise IntegrationBudget(f"{method} stopped before t = {t[-1]:.6g} s (its budget of "
+                                    f"{opts['max_num_steps']:.3g} steps between output times, or a failed step)") from None
+        return np.vstack([y0, Y])
+    if method == PROJECTED:
+        if len(t) < 2:
+            return y0[None]
+        dt = np.diff(t)
+        if not np.allclose(dt, dt[0], rtol=1e-9, atol=0):
+            raise ParameterError("method projected: needs evenly spaced output times")
+        w = float(np.max(np.abs(analyse(P[None])["eigenvalues"][0])))
+        n = max(1, math.ceil(dt[0] * steps_per_radian * w))
+        total = n * (len(t) - 1)
+        if total > max_steps:
+            raise IntegrationBudget(f"projected: {total:.3g} fixed steps needed (|eig|max = {w:.6g} rad/s, "
+                                    f"{steps_per_radian:g} steps per radian), over its budget of {max_steps:.3g}")
+        h = dt[0] / n
+        full, rest = divmod(n, CHUNK)
+        chunk = projected_stepper(P, h, CHUNK) if full else None
+        last = projected_stepper(P, h, rest) if rest else None
+        E0 = energy(values, y0[None])[0]
+        out, y = [y0], y0
+        for k in range(len(t) - 1):
+            for j in range(full):
+                if time.perf_counter() - start > max_s:
+                    raise IntegrationBudget(f"projected stopped at t = {t[k] + j * CHUNK * h:.6g} s of "
+                                            f"{t[-1]:.6g} s after {time.perf_counter() - start:.0f} s (its budget)")
+                y = np.array(chunk(y, E0))[:, -1]
+            if last is not None:
+                y = np.array(last(y, E0))[:, -1]
+            out.append(y)
+        return np.array(out)
+    raise ParameterError(f"--method: unknown method {method!r}; known: {' '.join(METHODS)}")
+
+
+def energy(values: dict, Y: np.ndarray) -> np.ndarray:
+    """E (2.3) along states Y (..., 8), the emitted `first_integral`."""
+    Y = np.atleast_2d(np.asarray(Y, float))
+    P = np.broadcast_to(model().vector(values), (len(Y), 10))
+    return np.asarray(function(model(), "first_integral")(np.ascontiguousarray(P), np.ascontiguousarray(Y[:, :4]),
+                                                         np.ascontiguousarray(Y[:, 4:]))[0]).reshape(-1)
+
+
+def initial_state(values: dict, perturb=(0.0, 0.0, 0.0, 0.0)) -> np.ndarray:
+    """(q, q') at t = 0: the relative equilibrium (0, 0, 0, epsilon0) plus `perturb` in the
+    angles, at rest."""
+    eps0 = float(analyse(model().vector(values)[None])["epsilon0"][0])
+    y = np.zeros(8)
+    y[3] = eps0
+    y[:4] += np.asarray(perturb, float)
+    return y
+
+
+def trajectory(values: dict, t, perturb=(0.0, 0.0, 0.0, 0.0), method: str = "DOP853"):
+    """A perturbed motion about the relative equilibrium as a gyro.results.AngleTrajectory
+    (the command line's: within the integration budget)."""
+    from gyro.results import AngleTrajectory
+
+    t = np.asarray(t, float)
+    y0 = initial_state(values, perturb)
+    Y = integrate(values, y0, t, method, budget_s=BUDGET_SECONDS, budget_steps=BUDGET_STEPS)
+    if not np.all(np.isfinite(Y)):
+        raise FloatingPointError(f"{method}: a coordinate is not finite")
+    return AngleTrajectory(model=MODEL, title=model().meta["title"], method=method, t=t,
+                           coordinates=("alpha", "beta", "gamma", "epsilon"), q=Y[:, :4],
+                           E=energy(values, Y), params=cli_params(values))

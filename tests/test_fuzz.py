@@ -1,0 +1,197 @@
+"""A seeded fuzz of the command line: 1,200 command lines over every command and
+parameter, valid and not (unknown names, NaN, inf, huge and tiny values, degenerate but
+valid physics, bad output paths). Each must end in one of the contract's ways: exit 0
+with strict output (one JSON object with --json, and no verdict beside a non-finite
+number), or exit 2 (bad input) or 1 (numerical failure) with one line on stderr; never a
+traceback, and never a run over 30 s."""
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import math
+import random
+import time
+
+import pytest
+
+from gyro.cli import main
+from gyro.models import load
+
+N_LINES = 1200
+SEED = 20261130
+WEIRD = ["nan", "inf", "-inf", "0", "-0", "-1", "1e-300", "1e300", "1e-12", "1e12", "abc", "", "1,5",
+         "9223372036854775808", "3", "0.5", "-1e300"]
+
+
+def _value(rng, default):
+    r = rng.random()
+    if r < 0.75:  # a valid-looking value near the default
+        return repr(default * rng.choice([0.1, 0.5, 0.9, 1.0, 1.1, 2.0, 10.0]) if default else rng.choice([0.0, 0.1, 1.0]))
+    return rng.choice(WEIRD)
+
+
+def _sets(rng, model, extra=(), k=None):
+    names = [p.name for p in model.params] + list(extra)
+    out = []
+    for _ in range(rng.randint(0, 3) if k is None else k):
+        name = rng.choice(names + ["nosuch", "", "m=1"]) if rng.random() < 0.95 else "=3"
+        default = next((p.default for p in model.params if p.name == name), 1.0)
+        out += ["--set", f"{name}={_value(rng, default)}" if rng.random() < 0.97 else name]
+    return out
+
+
+def _out(rng, tmp, stem):
+    return rng.choice([str(tmp / f"{stem}.png")] * 6 + [str(tmp), str(tmp / "nodir" / "x.png"), str(tmp / "x.txt"),
+                                                         str(tmp / ("n" * 300 + ".png"))])
+
+
+def command_lines(tmp):
+    rng = random.Random(SEED)
+    tg, gg = load("torsion_gyrocompass"), load("gimbal_gyroscope")
+    models = ["torsion_gyrocompass", "gimbal_gyroscope", "nosuch"]
+    for i in range(N_LINES):
+        cmd = rng.choice(["frequencies"] * 5 + ["params", "sweep", "sweep", "campbell", "stability-map",
+                                                "simulate", "simulate", "simulate", "bogus"])
+        if cmd == "frequencies":
+            model = rng.choice(models[:1] * 4 + models[1:])
+            argv = [cmd, model] + _sets(rng, tg)
+            if rng.random() < 0.6:
+                argv += ["--method", rng.choice(["formulas", "polyroots", "companion", "default", "default",
+                                                 "default", "nosuch"] + (["reference"] if rng.random() < 0.1 else []))]
+            if rng.random() < 0.6:
+                argv.append("--json")
+        elif cmd == "params":
+            argv = [cmd, rng.choice(models)]
+        elif cmd == "sweep":
+            x = rng.choice([p.name for p in tg.params] + ["nosuch"])
+            lo, hi = rng.choice([("0.1", "1"), ("0", "1e-4"), ("1", "0"), ("-1", "1"), ("1e-300", "1e300"), ("nan", "1"),
+                                 ("0.2", "inf")])
+            argv = [cmd, "torsion_gyrocompass", "--x", x, "--x-range", lo, hi,
+                    "--points", rng.choice(["2", "3", "5", "1", "0", "-3", "100001"])] + _sets(rng, tg, k=rng.randint(0, 1))
+            if rng.random() < 0.3:
+                argv += ["--method", rng.choice(["formulas", "companion", "default", "polyroots"])]
+            argv += rng.choice([["--json"], [], ["--out", _out(rng, tmp, f"s{i}")]])
+        elif cmd == "campbell":
+            argv = [cmd, rng.choice(["torsion_gyrocompass"] * 4 + ["gimbal_gyroscope"]), "--out", _out(rng, tmp, f"c{i}"),
+                    "--points", rng.choice(["2", "4", "6", "1", "-1", "100001"]), "--quiet"]
+            argv += rng.choice([[], ["--range", "0.5", "2"], ["--range", "1", "inf"], ["--range", "2", "1"],
+                                ["--range", "1e-300", "1e300"]]) + _sets(rng, tg, k=rng.randint(0, 1))
+        elif cmd == "stability-map":
+            x, y = rng.choice([p.name for p in tg.params] + ["nosuch"]), rng.choice(["H", "g", "l2", "u", "phi"])
+            argv = [cmd, "torsion_gyrocompass", "--x", x, "--x-range", *rng.choice([("0.1", "0.3"), ("-0.5", "0.3"),
+                                                                                    ("0", "1e300"), ("1", "1")]),
+                    "--y", y, "--y-range", *rng.choice([("0.1", "1"), ("0", "1e-4"), ("-90", "90")]),
+                    "--points", rng.choice(["2", "3", "4", "1", "1001"]), "--out", _out(rng, tmp, f"m{i}"), "--quiet"]
+            argv += rng.choice([[], ["--x-log"], ["--y-log"]])
+        elif cmd == "simulate":
+            argv = [cmd, rng.choice(["gimbal_gyroscope"] * 6 + ["torsion_gyrocompass"]),
+                    "--t-end", rng.choice(["0.01", "0.1", "1", "0", "-1", "nan", "1e308", "abc", "1e12"]),
+                    "--points", rng.choice(["2", "5", "21", "1", "x", "9223372036854775808", "1000000000"])]
+            argv += _sets(rng, gg, extra=("theta0", "dtheta0", "dpsi0", "dphi0"))
+            if rng.random() < 0.3:
+                m = rng.choice(["closed_form", "DOP853", "RK45", "cvodes", "nosuch"])
+                argv += ["--method", m]
+                if m not in ("closed_form", "nosuch"):
+                    argv[argv.index("--t-end") + 1] = rng.choice(["0.01", "0.05"])
+            argv += rng.choice([[], ["--json"], ["--out", _out(rng, tmp, f"t{i}")]])
+        else:
+            argv = [cmd] + rng.choice([[], ["--help-me"], ["torsion_gyrocompass"]])
+        yield argv
+
+
+N_VALID = 250
+DEGENERATE = {"u": [0.0, 1e-20], "g": [0.0], "phi": [90.0, -90.0, 0.0], "H": [1e-9, 1e3], "Kgamma": [1e-9, 1e9],
+              "I1": [1e-12], "l1": [-0.15, 0.0], "l2": [-0.25, 0.0], "K0": [1e-6, 1e12], "Kp": [1e-6, 1e12]}
+
+
+def valid_lines(tmp):
+    """Valid input only: every value within its kind and range, spread over decades, and the
+    degenerate but valid sets (no Earth rate, no gravity, the pole, a free or a stiff
+    bearing). These must never be refused as bad input."""
+    rng = random.Random(SEED + 1)
+    tg, gg = load("torsion_gyrocompass"), load("gimbal_gyroscope")
+
+    def sets(model, degenerate=False):
+        out = []
+        free = [p for p in model.params if p.name != "C0"]  # the closed form needs C0 = 0
+        for p in rng.sample(free, rng.randint(0, 3)):
+            if degenerate and p.name in DEGENERATE:
+                v = rng.choice(DEGENERATE[p.name])
+            elif p.name == "phi":
+                v = rng.uniform(-90, 90)
+            else:
+                v = p.default * 10 ** rng.uniform(-2, 2) if p.default else rng.uniform(0, 1)
+                if p.kind == "real" and rng.random() < 0.3:
+                    v = -v
+            out += ["--set", f"{p.name}={v!r}"]
+        return out
+
+    for i in range(N_VALID):
+        cmd = rng.choice(["frequencies"] * 4 + ["sweep", "campbell", "stability-map", "simulate", "simulate"])
+        deg = rng.random() < 0.4
+        if cmd == "frequencies":
+            argv = [cmd, "torsion_gyrocompass"] + sets(tg, deg) + ["--method", rng.choice(
+                ["formulas", "companion", "default", "default", "polyroots"])] + rng.choice([["--json"], []])
+        elif cmd == "sweep":
+            argv = [cmd, "torsion_gyrocompass", "--x", "H", "--x-range", "0.1", "1", "--points", "3", "--json"] + sets(tg, deg)
+        elif cmd == "campbell":
+            argv = [cmd, "torsion_gyrocompass", "--out", str(tmp / f"vc{i}.png"), "--points", "3", "--quiet"] + sets(tg, deg)
+        elif cmd == "stability-map":
+            argv = [cmd, "torsion_gyrocompass", "--x", "l2", "--x-range", "-0.5", "0.3", "--y", "H", "--y-range",
+                    "0.01", "10", "--y-log", "--points", "2", "--out", str(tmp / f"vm{i}.png"), "--quiet"] + sets(tg, deg)
+        else:
+            ic = [f"theta0={rng.uniform(0.05, 3.0)!r}", f"dtheta0={rng.uniform(-5, 5)!r}",
+                  f"dpsi0={rng.uniform(-5, 5)!r}", f"dphi0={rng.uniform(-500, 500)!r}"]
+            argv = [cmd, "gimbal_gyroscope", "--t-end", repr(rng.uniform(0.01, 10)), "--points", "11", "--json"]
+            argv += [a for x in rng.sample(ic, 2) for a in ("--set", x)] + sets(gg)
+            if rng.random() < 0.2:
+                argv += ["--method", "DOP853", "--set", "C0=0.003"]
+                argv[argv.index("--t-end") + 1] = "0.1"
+        yield argv
+
+
+def run(argv):
+    out, err = io.StringIO(), io.StringIO()
+    t0 = time.perf_counter()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = main(argv)
+        except SystemExit as exc:  # argparse's usage errors
+            code = exc.code
+    return code, out.getvalue(), err.getvalue(), time.perf_counter() - t0
+
+
+def test_fuzz_of_the_command_line(tmp_path):
+    worst, count = 0.0, 0
+    for argv in command_lines(tmp_path):
+        code, out, err, dt = run(argv)
+        count += 1
+        worst = max(worst, dt)
+        where = " ".join(argv)
+        assert dt < 30, f"{where}: {dt:.1f} s"
+        assert "Traceback" not in err and "Traceback" not in out, where
+        assert code in (0, 1, 2), f"{where}: exit {code}"
+        if code:
+            assert len(err.strip().splitlines()) == 1 and err.startswith(("gyro", "usage")), f"{where}: {err!r}"
+        elif "--json" in argv:
+            doc = json.loads(out, parse_constant=lambda c: pytest.fail(f"{where}: {c} in the JSON"))
+            if isinstance(doc, dict) and "stability" in doc and isinstance(doc["stability"], dict):
+                if doc["stability"]["class"] not in ("failed", "unknown"):
+                    assert all(math.isfinite(f) for f in doc["frequencies"]), where
+    assert count == N_LINES and worst < 30
+
+
+def test_valid_input_is_answered_or_fails_numerically_never_refused(tmp_path):
+    codes = []
+    for argv in valid_lines(tmp_path):
+        code, out, err, dt = run(argv)
+        where = " ".join(argv)
+        assert dt < 30, f"{where}: {dt:.1f} s"
+        assert "Traceback" not in err and code in (0, 1), f"{where}: exit {code}: {err}"
+        if code:
+            assert len(err.strip().splitlines()) == 1, f"{where}: {err!r}"
+        elif "--json" in argv:
+            json.loads(out, parse_constant=lambda c: pytest.fail(f"{where}: {c} in the JSON"))
+        codes.append(code)
+    assert len(codes) == N_VALID and codes.count(0) > 0.9 * N_VALID

@@ -18,7 +18,7 @@ import pytest
 from gyro.cli import main
 from gyro.models import load
 
-N_LINES = 1200
+N_LINES = 1400
 SEED = 20261130
 WEIRD = ["nan", "inf", "-inf", "0", "-0", "-1", "1e-300", "1e300", "1e-12", "1e12", "abc", "", "1,5",
          "9223372036854775808", "3", "0.5", "-1e300"]
@@ -48,11 +48,12 @@ def _out(rng, tmp, stem):
 
 def command_lines(tmp):
     rng = random.Random(SEED)
-    tg, gg = load("torsion_gyrocompass"), load("gimbal_gyroscope")
+    tg, gg, ghc = load("torsion_gyrocompass"), load("gimbal_gyroscope"), load("gyrohorizoncompass")
     models = ["torsion_gyrocompass", "gimbal_gyroscope", "nosuch"]
     for i in range(N_LINES):
         cmd = rng.choice(["frequencies"] * 5 + ["params", "sweep", "sweep", "campbell", "stability-map",
-                                                "simulate", "simulate", "simulate", "bogus"])
+                                                "simulate", "simulate", "simulate", "bogus", "stability", "stability",
+                                                "map", "ghc-simulate"])
         if cmd == "frequencies":
             model = rng.choice(models[:1] * 4 + models[1:])
             argv = [cmd, model] + _sets(rng, tg)
@@ -95,6 +96,19 @@ def command_lines(tmp):
                 if m not in ("closed_form", "nosuch"):
                     argv[argv.index("--t-end") + 1] = rng.choice(["0.01", "0.05"])
             argv += rng.choice([[], ["--json"], ["--out", _out(rng, tmp, f"t{i}")]])
+        elif cmd == "stability":
+            argv = [cmd, rng.choice(["gyrohorizoncompass"] * 5 + ["torsion_gyrocompass"])]
+            argv += _sets(rng, ghc, extra=("lambda",)) + rng.choice([[], ["--orbit"]]) + rng.choice([[], ["--json"]])
+        elif cmd == "map":
+            axis = lambda: f"{rng.choice(['zeta', 'eta', 'theta', 'chi', 'nu', 'L', 'nosuch'])}={rng.choice(['0.05:0.8', '0:1', '1:0', 'nan:1', '0:1e300', '0.1'])}:{rng.choice(['3', '4', '1', '0', 'x', '100000'])}"  # noqa: E731
+            argv = [cmd, "gyrohorizoncompass", "--x", axis(), "--y", axis(), "--out", _out(rng, tmp, f"g{i}")]
+            argv += _sets(rng, ghc, k=rng.randint(0, 1)) + rng.choice([[], ["--json"], ["--orbit"]])
+        elif cmd == "ghc-simulate":
+            argv = ["simulate", "gyrohorizoncompass", "--t-end", rng.choice(["1", "10", "0", "-1", "nan", "1e308"]),
+                    "--points", rng.choice(["2", "5", "1", "x"])] + _sets(rng, ghc, extra=("lambda",))
+            argv += rng.choice([[], ["--perturb", "0.01,0,0,0"], ["--perturb", "1,2"], ["--perturb", "nan,0,0,0"],
+                                ["--perturb", "1e300,0,0,0"]])
+            argv += rng.choice([[], ["--json"], ["--method", rng.choice(["DOP853", "projected", "nosuch"])]])
         else:
             argv = [cmd] + rng.choice([[], ["--help-me"], ["torsion_gyrocompass"]])
         yield argv
@@ -127,8 +141,26 @@ def valid_lines(tmp):
             out += ["--set", f"{p.name}={v!r}"]
         return out
 
+    from tests.test_ghc_cli import LAB
+
+    def lab_sets():
+        v = dict(LAB)
+        for k in rng.sample(["J", "L", "zeta", "eta"], 2):
+            v[k] = v[k] * rng.uniform(0.8, 1.2)
+        v["zeta"] = min(v["zeta"], 0.6 * 2 * v["L"] / v["I"])  # I lambda zeta/2L < 1: an equilibrium (lambda ~ 1)
+        return [f"--set={k}={x!r}" for k, x in v.items()]
+
     for i in range(N_VALID):
-        cmd = rng.choice(["frequencies"] * 4 + ["sweep", "campbell", "stability-map", "simulate", "simulate"])
+        cmd = rng.choice(["frequencies"] * 4 + ["sweep", "campbell", "stability-map", "simulate", "simulate",
+                                                "ghc"])
+        if cmd == "ghc":
+            argv = rng.choice([["stability", "gyrohorizoncompass", "--json"] + lab_sets(),
+                               ["simulate", "gyrohorizoncompass", "--t-end", "5", "--points", "5", "--json",
+                                "--perturb", "0.01,0,0,0"] + lab_sets(),
+                               ["map", "gyrohorizoncompass", "--x", "zeta=0.05:0.85:3", "--y", "eta=-0.5:0.5:3",
+                                "--out", str(tmp / f"vg{i}.png")] + [f"--set={k}={LAB[k]!r}" for k in ("A", "B", "C", "J", "L", "I", "nu")]])
+            yield argv
+            continue
         deg = rng.random() < 0.4
         if cmd == "frequencies":
             argv = [cmd, "torsion_gyrocompass"] + sets(tg, deg) + ["--method", rng.choice(

@@ -19,7 +19,7 @@ import json
 import math
 from pathlib import Path
 
-from gyro.cli.common import add_json, add_set, parse_sets
+from gyro.cli.common import add_json, add_set, check_png_out, parse_sets
 from gyro.errors import ParameterError
 
 ORDER = 50
@@ -63,8 +63,6 @@ def _number(name: str, raw: str) -> float:
 
 def parse(args):
     """(Motion, times, method) from the arguments, or ParameterError naming the input."""
-    import numpy as np
-
     from gyro.analyses.gimbal import METHODS, Motion
     from gyro.models import load
 
@@ -90,25 +88,13 @@ def parse(args):
         except (TypeError, ValueError):
             raise ParameterError(f"parameter {name}: not a number: {raw!r}") from None
         p.check(init[name])
-    t_end = _number("--t-end", args.t_end)
-    if not t_end > 0:
-        raise ParameterError(f"--t-end must be positive, got {args.t_end!r}")
-    try:
-        points = int(args.points)
-    except ValueError:
-        raise ParameterError(f"--points: not an integer: {args.points!r}") from None
-    if not 2 <= points <= MAX_POINTS:
-        raise ParameterError(f"--points must lie in 2..{MAX_POINTS}, got {points}")
+    t = _times(args)
     if args.method not in METHODS:
         raise ParameterError(f"--method: unknown method {args.method!r}; known: {' '.join(METHODS)}")
     if args.out is not None:
-        out = Path(args.out)
-        if out.suffix.lower() != ".png":
-            raise ParameterError(f"--out: expected a .png file name, got {args.out!r}")
-        if not out.parent.is_dir() if str(out.parent) else False:
-            raise ParameterError(f"--out: no such directory: {str(out.parent)!r}")
+        check_png_out(args.out)  # a .png in a writable folder, not a folder, not too long a name
     motion = Motion(values, init["theta0"], init["dtheta0"], init["dpsi0"], init["dphi0"])
-    return motion, np.linspace(0.0, t_end, points), args.method
+    return motion, t, args.method
 
 
 def _times(args):
@@ -130,7 +116,6 @@ def _run_ghc(args) -> int:
     """gyrohorizoncompass: every input checked first (names, numbers, equilibrium, --perturb,
     --t-end, --points, --method, --out), then integrated."""
     from gyro.analyses import gyrohorizoncompass as ghc
-    from gyro.cli.common import check_png_out
 
     values = ghc.parameters(parse_sets(args.set))
     perturb = [0.0] * 4

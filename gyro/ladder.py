@@ -42,7 +42,13 @@ def spectrum(model: Model, params, method: str = "default", tol: float = DEFAULT
     model.param_names) by one method of the ladder."""
     if method not in METHODS:
         raise ValueError(f"method: unknown {method!r}; known: {', '.join(METHODS)}")
-    return get(method).solve(model, as_batch(model, params), tol)
+    P = as_batch(model, params)
+    if P.shape[0] == 0:  # an empty batch: an empty spectrum
+        n = len(model.meta["reduced"])
+        empty = np.zeros((0, n))
+        return Spectrum(method, empty, empty.copy(), empty.copy(),
+                        np.zeros((0, len(model.meta["equilibrium_coordinates"]))), np.zeros(0, object))
+    return get(method).solve(model, P, tol)
 
 
 def natural_frequencies(model: Model, values: dict, method: str = "default") -> ModalResult:

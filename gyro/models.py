@@ -102,8 +102,7 @@ class Model:
         """The parameter vector, in the order of param_names: the given values, validated,
         and the paper example's for the others; an unknown name is a ParameterError
         naming it."""
-        v = self.parameters(values) if set(values or {}) - set(self.defaults) or any(
-            not isinstance(x, (int, float)) for x in (values or {}).values()) else {**self.defaults, **(values or {})}
+        v = self.parameters(values)
         return np.array([v[n] for n in self.param_names], dtype=float)
 
     def vectors(self, batch: list[dict]) -> np.ndarray:

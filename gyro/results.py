@@ -161,7 +161,9 @@ class Spectrum:
             lines.append(row)
         label = stab.label[k]
         note = {"unstable": f", {stab.unstable_roots[k]} growing root(s), the fastest at {stab.growth_rate[k]:.6g} 1/s",
-                "unknown": " (a root's error is unbounded: this method cannot tell; try --method default)",
+                "unknown": (" (the formulas compute no growth rates: no verdict; try --method default)"
+                            if self.method == "formulas" else
+                            " (a root's error is unbounded: this method cannot tell; try --method default)"),
                 "failed": " (these parameters could not be computed)"}.get(label, "")
         lines.append(f"equilibrium: {label}{note}")
         return "\n".join(lines)
@@ -208,7 +210,8 @@ def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
     times |lambda| (the conservative gyroscopic spectrum lies on the imaginary axis, so a
     real part within rounding of it is noise). A root with |lambda| within its own error of
     zero (estimate >= 1: a neutral direction, omega1 at the pole or without Earth rate) is
-    marginal. No verdict without a bound: a set with a frequency or growth rate that is not
+    marginal, and so is an exact zero root. The formulas, which compute no growth rates,
+    give no verdict ('unknown'). No verdict without a bound: a set with a frequency or growth rate that is not
     finite is 'failed' (it could not be computed), and one where a root's error is
     unbounded (infinite or NaN: a method that lost a root, as polyroots does) is 'unknown',
     unless a root with a bounded error grows, which makes it 'unstable' all the same."""
@@ -216,10 +219,16 @@ def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
     est = np.asarray(spec.error_estimate, dtype=float)
     bounded = np.isfinite(est)
     allow = np.maximum(np.where(bounded, est, np.inf), rel) * lam
-    growing = (spec.growth > allow) & bounded
-    neutral = bounded & (est >= 1)
+    # a root resolved from zero has a relative error below 1/2; one that is not (a rounded
+    # split of a double zero root, 3e-20 with an error of 0.95) shows no growth, and it is
+    # neutral, as is an exact zero root (lambda = 0: a free direction)
+    resolved = bounded & (est < 0.5)
+    growing = (spec.growth > allow) & resolved
+    neutral = bounded & ~resolved | (lam == 0)
     failed = ~np.all(np.isfinite(spec.frequencies) & np.isfinite(spec.growth), axis=1)
     unknown = ~np.all(bounded, axis=1)
+    if spec.method == "formulas":  # the formulas assume a stable gyrocompass: no growth rates
+        unknown = np.ones(len(lam), bool)
     label = np.where(failed, "failed", np.where(
         growing.any(axis=1), "unstable", np.where(
             unknown, "unknown", np.where(neutral.any(axis=1), "marginal", "stable"))))
@@ -510,6 +519,11 @@ class Trajectory:
         plt.close(fig)
 
 
+def _finite_or_none(a) -> list:
+    """Rows of numbers for strict JSON: a value that could not be computed is null."""
+    return [[float(v) if np.isfinite(v) else None for v in row] for row in np.asarray(a, float)]
+
+
 @dataclass
 class FrequencySweep:
     """Natural frequencies against one parameter (a Campbell diagram over any parameter)."""
@@ -526,7 +540,8 @@ class FrequencySweep:
         """The `gyro sweep --json` document."""
         s = self.spectrum
         return {"model": self.model, "x": {"name": self.xname, "unit": self.xunit, "values": self.x.tolist()},
-                "method": s.method, "frequencies": s.frequencies.tolist(), "eigenvalues_re": s.growth.tolist(),
+                "method": s.method, "frequencies": _finite_or_none(s.frequencies),
+                "eigenvalues_re": _finite_or_none(s.growth),
                 "error_estimate": [[float(e) if np.isfinite(e) else None for e in row] for row in s.error_estimate],
                 "stability": [str(c) for c in classify(s).label]}
 

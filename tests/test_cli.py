@@ -119,3 +119,22 @@ def test_modal_result_saves_and_loads_itself(tmp_path):
     r.save(tmp_path / "modes.json")
     back = ModalResult.load(tmp_path / "modes.json")
     assert back == r and back.frequencies[1] == r.frequencies[1] and back.params["phi"] == 45.0
+
+
+def test_found_in_review_cli(tmp_path):
+    """A range may start at a negative number written with an exponent; campbell needs a
+    spin to sweep (exit 2, not a numerical failure); a sweep's JSON holds null where a
+    value could not be computed; the formulas give no stability verdict."""
+    from gyro.cli import main as gyro_main
+
+    r = gyro("stability-map", "torsion_gyrocompass", "--x", "l2", "--x-range", "-1e-4", "1e-4", "--y", "H",
+             "--y-range", "0.1", "1", "--points", "2", "--out", str(tmp_path / "m.png"), "--quiet")
+    assert r.returncode == 0, r.stderr
+    r = gyro("campbell", "gyrohorizoncompass", "--out", str(tmp_path / "c.png"))
+    assert r.returncode == 2 and "no rotor momentum H" in r.stderr
+    r = gyro("sweep", "torsion_gyrocompass", "--x", "H", "--x-range", "1", "1e12", "--x-log", "--points", "3", "--json")
+    doc = json.loads(r.stdout)
+    assert r.returncode == 1 and None in doc["frequencies"][-1] and "no finite spectrum" in r.stderr
+    r = gyro("frequencies", "torsion_gyrocompass", "--method", "formulas", "--json")
+    assert json.loads(r.stdout)["stability"]["class"] == "unknown"
+    assert callable(gyro_main)

@@ -98,17 +98,15 @@ def test_companion_loses_digits_on_the_small_root():
     assert err[-1] < 1e-13  # the large roots are fine
 
 
-def test_default_answers_the_zero_root_at_the_pole_where_omega1_is_rounding():
+def test_default_escalates_at_the_pole_where_omega1_is_rounding():
     """At phi = 90 deg, u2 = 0 and omega1 = 0; in double cos(pi/2) rounds to 6e-17 and the
-    computed omega1 is noise. K is singular to rounding there, so lambda = 0 is a root: the
-    default answers it as 0 with an estimate of 1 (no correct digit) without the 40-digit
-    rung, which agrees (its omega1 is below 1e-8 with an estimate >= 1); the equilibrium
-    is classified marginal, not stable."""
+    computed omega1 is noise. K is not exactly singular (its smallest singular value is
+    2e-17, not 0), so the default does not take omega1 for an exact zero: it measures the
+    inputs' rounding, escalates to the reference, and states an estimate >= 1 for omega1
+    (no correct digit): the equilibrium is classified marginal, not stable."""
     s = ladder.spectrum(MODEL, params(phi=90.0), "default")
-    assert s.route[0] == "general, a zero root"
-    assert s.error_estimate[0][0] >= 1 and s.frequencies[0][0] == 0.0
-    r = ladder.spectrum(MODEL, params(phi=90.0), "reference")
-    assert r.frequencies[0][0] < 1e-8 and r.error_estimate[0][0] >= 1
+    assert s.route[0] == "reference"
+    assert s.error_estimate[0][0] >= 1 and s.frequencies[0][0] < 1e-8
     assert np.all(s.error_estimate[0][1:] <= TOL)
     assert ladder.classify(s).label[0] == "marginal"
     # and the formulas rung says the same of its omega1 (rounding of u2 in its estimate)
@@ -119,6 +117,24 @@ def test_default_answers_the_zero_root_at_the_pole_where_omega1_is_rounding():
 def test_without_earth_rate_the_azimuth_is_neutral():
     s = ladder.spectrum(MODEL, params(u=0.0), "default")
     assert ladder.classify(s).label[0] == "marginal"
+    # K exactly singular: the zero root answered without the 40-digit rung, as 0
+    assert s.route[0] == "general, a zero root" and s.frequencies[0][0] == 0.0
+
+
+@pytest.mark.parametrize("over, label", [
+    ({"u": 0.0, "g": 1.0}, "marginal"),  # a zero root found exactly (estimate 0): still neutral
+    ({"u": 0.0, "g": 0.0}, "marginal"),  # two zero pairs
+    ({"u": 0.0, "H": 1e-9}, "marginal"),
+    ({"u": 1e-8, "phi": 89.9999}, "stable"),  # a small true omega1 (2.6e-7): not a zero root
+])
+def test_zero_roots_are_neutral_and_small_roots_are_not_taken_for_zero(over, label):
+    """Found in review: an exact zero root with an estimate of 0 was called stable, and the
+    zero-root shortcut fired on a small true root. Both now agree with the reference."""
+    s = ladder.spectrum(MODEL, params(**over), "default")
+    assert ladder.classify(s).label[0] == label, (over, s.frequencies[0][:2], s.error_estimate[0][:2], s.route)
+    if label == "stable":
+        r = ladder.spectrum(MODEL, params(**over), "reference")
+        assert abs(s.frequencies[0][0] / r.frequencies[0][0] - 1) <= s.error_estimate[0][0]
 
 
 FORMULA_CASES = {

@@ -95,3 +95,15 @@ def test_trajectory_gives_the_cli_json_saves_and_plots(method, tmp_path):
     assert back.integrals == tr.integrals and back.method == method
     tr.plot(tmp_path / "t.png")
     assert (tmp_path / "t.png").exists()
+
+
+def test_found_in_review_api(tmp_path):
+    """An empty batch gives an empty spectrum; vector validates every value it is given."""
+    from gyro.models import ParameterError
+
+    empty = ladder.spectrum(MODEL, np.empty((0, len(MODEL.param_names))))
+    assert empty.frequencies.shape == (0, 10) and len(empty) == 0
+    for bad in ({"m": -1.0}, {"phi": 500.0}, {"g": float("nan")}, {"mass": 1.0}):
+        with pytest.raises(ParameterError):
+            MODEL.vector(bad)
+    assert MODEL.vector({"H": 0.9})[MODEL.param_names.index("H")] == 0.9

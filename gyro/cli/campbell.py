@@ -27,6 +27,8 @@ def run(args) -> int:
     from gyro.analyses.campbell import sweep
 
     model = model_with_equilibrium(args.model)
+    if "H" not in model.param_names:
+        raise ParameterError(f"campbell: {model.name} has no rotor momentum H to sweep")
     values = model.parameters(parse_sets(args.set))
     lo, hi = args.range
     if not (0 < lo < hi) or not math.isfinite(hi) or not math.isfinite(hi * values.get("H", 1.0)):

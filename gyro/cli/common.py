@@ -14,7 +14,14 @@ SET_HELP = "parameter value in SI units (phi in degrees); repeat as needed"
 
 
 class Parser(argparse.ArgumentParser):
-    """argparse that reports a usage error in one line and exits with 2."""
+    """argparse that reports a usage error in one line and exits with 2, and reads a value
+    such as -1e-4 as a number, not as an option."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        import re
+
+        self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
     def error(self, message):
         print(f"{self.prog}: error: {message}", file=sys.stderr)

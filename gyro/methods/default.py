@@ -68,17 +68,18 @@ def solve(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
         roots, e = qep.general(M[k], D[k], K[k])
         e = e + qep.input_rounding(model, P[k], roots, lambda Pp: qep.general_at(model, Pp))
         freq[k], growth[k], est[k] = np.abs(roots.imag), roots.real, e
-        # an exact zero root (omega1 without Earth rate, u2 = 0: a free azimuth). lambda = 0
-        # is a root exactly when K is singular; then the smallest root, if it is within tol
-        # of the spectrum's scale and the others are answered, is that zero: 0 with a
-        # relative error of 1 (marginal), cheaply, where the 40-digit rung would only
-        # confirm a number like 1e-36 after a second
+        # an exact zero root (omega1 without Earth rate, u = 0: a free azimuth). lambda = 0 is
+        # a root exactly when K is singular; where K is singular in double precision to the
+        # last bit (its smallest singular value is 0, not merely small: u cos(phi) = 1e-17
+        # at the pole, or a tiny u, leave a small true root that the 40-digit rung resolves)
+        # the smallest root, within tol of the spectrum's scale while the others are
+        # answered, is that zero: 0 with a relative error of 1 (marginal), cheaply
         lam = np.abs(roots)
         j = int(np.argmin(lam))
         others = np.arange(n) != j
         if e[j] > tol and lam[j] <= tol * np.max(lam) and np.all(e[others] <= tol):
             sv = np.linalg.svd(K[k], compute_uv=False)
-            if sv[-1] <= 1e3 * qep.EPS * sv[0]:
+            if sv[-1] == 0.0:
                 freq[k, j], growth[k, j], est[k, j] = 0.0, 0.0, 1.0
                 zero_root[k, j] = True
                 route[k] = "general, a zero root"

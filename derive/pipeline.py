@@ -67,7 +67,6 @@ class Derivation:
     operator: mech.LinearOperator  # exact, at the reference, function of `even`
     route_agreement: float  # max |route1 - route2| / max |route2| at random points
     order: list = field(default_factory=list)  # names of the reduced coordinates
-    forces: list = field(default_factory=list)  # generalised forces Q, all coordinates
     rates: dict = field(default_factory=dict)  # velocity symbol -> rate on a steady motion
     inputs: list = field(default_factory=list)  # w: columns of B (symbols)
     input_matrix: sp.Matrix | None = None  # B of M q'' + D q' + K q = B w
@@ -158,7 +157,6 @@ def _check_declared(model: Model, L, Q) -> None:
     known = set(model.symbols) | set(model.q) | set(model.qd) | set(model.signal_symbols) | {TIME}
     known |= set(model.given_values) | set(model.given_derivatives) | set(model.given_constants)
     known |= {s for s in model.cyclic.values() if isinstance(s, sp.Symbol)}
-    known |= set().union(*[sp.sympify(r).free_symbols for r in model.steady.values()]) if model.steady else set()
     free = set(L.free_symbols).union(*[sp.sympify(x).free_symbols for x in (Q or [])])
     unknown = sorted(map(str, free - known))
     if unknown:
@@ -300,7 +298,7 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
 
     deriv = Derivation(model=model, mass_matrix=Mq, forcing=f, routhian=R, rq=rq, rqd=rqd,
                        rqdd=rqdd, even=even, equilibrium_residual=residual, operator=op2,
-                       route_agreement=agreement, order=order, forces=Q or [], rates=rates,
+                       route_agreement=agreement, order=order, rates=rates,
                        time_dependent=time_dependent)
 
     w = list(model.given_values) + list(model.given_derivatives) + list(model.input_signal_symbols)

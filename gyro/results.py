@@ -79,6 +79,15 @@ def _clean_stale(out: Path) -> None:
             pass
 
 
+def _shown_rows(n: int):
+    """The rows a text table of a motion shows: all up to 21, else 11 spread evenly."""
+    return range(n) if n <= 21 else np.unique(np.linspace(0, n - 1, 11).round().astype(int))
+
+
+def _more_rows(n: int) -> list[str]:
+    return [f"({n} points; 11 shown; --json prints all)"] if n > 21 else []
+
+
 def save_figure(fig, out) -> None:
     """A figure written atomically: a temporary file in the same folder, renamed. A failed
     run leaves nothing half-written; a killed one leaves a temporary named after the output
@@ -115,6 +124,7 @@ class Spectrum:
     error_estimate: np.ndarray  # relative error bound per frequency
     equilibrium: np.ndarray | None = None  # (sets, equilibrium coordinates)
     route: np.ndarray = field(default=None)  # per set: which rung answered (default only)
+    growth_known: bool = True  # False for a method that computes no growth rates (formulas)
 
     def __len__(self) -> int:
         return self.frequencies.shape[0]
@@ -124,7 +134,7 @@ class Spectrum:
         """One spectrum of the sets of several, in order."""
         cat = {f: (None if getattr(parts[0], f) is None else np.concatenate([getattr(x, f) for x in parts]))
                for f in ("frequencies", "growth", "error_estimate", "equilibrium", "route")}
-        return cls(parts[0].method, **cat)
+        return cls(parts[0].method, **cat, growth_known=all(p.growth_known for p in parts))
 
     def to_dict(self, k: int, model, params: dict) -> dict:
         """The `gyro frequencies --json` document of set k (its keys are the contract)."""
@@ -161,8 +171,8 @@ class Spectrum:
             lines.append(row)
         label = stab.label[k]
         note = {"unstable": f", {stab.unstable_roots[k]} growing root(s), the fastest at {stab.growth_rate[k]:.6g} 1/s",
-                "unknown": (" (the formulas compute no growth rates: no verdict; try --method default)"
-                            if self.method == "formulas" else
+                "unknown": (f" (the method '{self.method}' computes no growth rates: no verdict; try --method "
+                            "default)" if not self.growth_known else
                             " (a root's error is unbounded: this method cannot tell; try --method default)"),
                 "failed": " (these parameters could not be computed)"}.get(label, "")
         lines.append(f"equilibrium: {label}{note}")
@@ -210,8 +220,8 @@ def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
     times |lambda| (the conservative gyroscopic spectrum lies on the imaginary axis, so a
     real part within rounding of it is noise). A root with |lambda| within its own error of
     zero (estimate >= 1: a neutral direction, omega1 at the pole or without Earth rate) is
-    marginal, and so is an exact zero root. The formulas, which compute no growth rates,
-    give no verdict ('unknown'). No verdict without a bound: a set with a frequency or growth rate that is not
+    marginal, and so is an exact zero root. A method that computes no growth rates (the
+    formulas: Spectrum.growth_known) gives no verdict ('unknown'). No verdict without a bound: a set with a frequency or growth rate that is not
     finite is 'failed' (it could not be computed), and one where a root's error is
     unbounded (infinite or NaN: a method that lost a root, as polyroots does) is 'unknown',
     unless a root with a bounded error grows, which makes it 'unstable' all the same."""
@@ -227,7 +237,7 @@ def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
     neutral = bounded & ~resolved | (lam == 0)
     failed = ~np.all(np.isfinite(spec.frequencies) & np.isfinite(spec.growth), axis=1)
     unknown = ~np.all(bounded, axis=1)
-    if spec.method == "formulas":  # the formulas assume a stable gyrocompass: no growth rates
+    if not spec.growth_known:  # the formulas assume a stable gyrocompass: no growth rates
         unknown = np.ones(len(lam), bool)
     label = np.where(failed, "failed", np.where(
         growing.any(axis=1), "unstable", np.where(
@@ -490,13 +500,10 @@ class Trajectory:
             period = ("none (stationary or on the separatrix)" if not math.isfinite(self.period)
                       else f"{self.period:.9g} s")
             lines.append(f"motion: {self.motion_type}; period of theta {period}")
-        rows = range(len(t)) if len(t) <= 21 else np.unique(np.linspace(0, len(t) - 1, 11).round().astype(int))
         lines.append(f"{'t [s]':>14} {'theta [rad]':>18} {'psi [rad]':>18} {'phi [rad]':>18}")
-        for i in rows:
+        for i in _shown_rows(len(t)):
             lines.append(f"{t[i]:>14.6g} {self.theta[i]:>18.12g} {self.psi[i]:>18.12g} {self.phi[i]:>18.12g}")
-        if len(t) > 21:
-            lines.append(f"({len(t)} points; 11 shown; --json prints all)")
-        return "\n".join(lines)
+        return "\n".join(lines + _more_rows(len(t)))
 
     def save(self, path) -> None:
         _save_npz(self, path)
@@ -735,13 +742,10 @@ class AngleTrajectory:
         t, q = np.asarray(self.t), np.asarray(self.q)
         lines = [f"{self.title} ({self.model}), method {self.method}",
                  f"E(0) = {self.E[0]:.12g}; max |E - E(0)|/|E(0)| = {self.drift:.2g}"]
-        rows = range(len(t)) if len(t) <= 21 else np.unique(np.linspace(0, len(t) - 1, 11).round().astype(int))
         lines.append(f"{'t [s]':>12}" + "".join(f"{n + ' [rad]':>18}" for n in self.coordinates))
-        for i in rows:
+        for i in _shown_rows(len(t)):
             lines.append(f"{t[i]:>12.6g}" + "".join(f"{v:>18.11g}" for v in q[i]))
-        if len(t) > 21:
-            lines.append(f"({len(t)} points; 11 shown; --json prints all)")
-        return "\n".join(lines)
+        return "\n".join(lines + _more_rows(len(t)))
 
     def save(self, path) -> None:
         _save_npz(self, path)

@@ -51,6 +51,22 @@ def tg_functions():
     return derived(MODEL)[2]
 
 
+def run_cli(*args):
+    """`gyro ARGS` in this process: (exit code, stdout, stderr); argparse's usage errors too."""
+    import io
+    from contextlib import redirect_stderr, redirect_stdout
+
+    from gyro.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with redirect_stdout(out), redirect_stderr(err):
+        try:
+            rc = main(list(args))
+        except SystemExit as exc:
+            rc = exc.code
+    return rc, out.getvalue(), err.getvalue()
+
+
 def compile_c(model: str, tmp: Path) -> ctypes.CDLL:
     """Compile the generated C of a model with -Wall -Wextra -Werror into a shared library."""
     cc = shutil.which("gcc") or shutil.which("cc")

@@ -220,10 +220,13 @@ def test_valid_input_is_answered_or_fails_numerically_never_refused(tmp_path):
         code, out, err, dt = run(argv)
         where = " ".join(argv)
         assert dt < 30, f"{where}: {dt:.1f} s"
-        assert "Traceback" not in err and code in (0, 1), f"{where}: exit {code}: {err}"
+        # valid input is answered; the one exception is a paper formula outside its domain
+        # (a square root of a negative number at far-off parameters): exit 1, one line
+        formulas = "--method" in argv and argv[argv.index("--method") + 1] == "formulas"
+        assert "Traceback" not in err and (code == 0 or (code == 1 and formulas)), f"{where}: exit {code}: {err}"
         if code:
             assert len(err.strip().splitlines()) == 1, f"{where}: {err!r}"
         elif "--json" in argv:
             json.loads(out, parse_constant=lambda c: pytest.fail(f"{where}: {c} in the JSON"))
         codes.append(code)
-    assert len(codes) == N_VALID and codes.count(0) > 0.9 * N_VALID
+    assert len(codes) == N_VALID

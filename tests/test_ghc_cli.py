@@ -3,30 +3,21 @@ command-line contract of `gyro stability`, `gyro map` and `gyro simulate gyrohor
 (names, keys, exit codes). docs/gyrohorizoncompass.md, section "Item 4"."""
 from __future__ import annotations
 
-import io
 import json
 import math
-from contextlib import redirect_stderr, redirect_stdout
 
 import numpy as np
 import pytest
 
 from gyro.analyses import gyrohorizoncompass as ghc
-from gyro.cli import main
+from tests.conftest import run_cli
 
 LAB = {"A": 1.0, "B": 1.05, "C": 1.1, "J": 1.0, "L": 0.5, "I": 1.0, "nu": 1.0, "zeta": 0.5, "eta": 0.2}
 LAB_SETS = [f"--set={k}={v}" for k, v in LAB.items()]
 BASE = [f"--set={k}={LAB[k]}" for k in ("A", "B", "C", "J", "L", "I", "nu")]
 
 
-def gyro(*args):
-    out, err = io.StringIO(), io.StringIO()
-    with redirect_stdout(out), redirect_stderr(err):
-        try:
-            rc = main(list(args))
-        except SystemExit as exc:  # argparse's own usage errors
-            rc = exc.code
-    return rc, out.getvalue(), err.getvalue()
+gyro = run_cli  # `gyro ARGS` in this process: (exit code, stdout, stderr)
 
 
 def _random_sets(rng, n, orbit=False):

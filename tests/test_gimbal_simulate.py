@@ -1,25 +1,16 @@
 """The command-line contract of `gyro simulate gimbal_gyroscope` (names, keys, exit codes)."""
 from __future__ import annotations
 
-import io
 import json
 import math
-from contextlib import redirect_stderr, redirect_stdout
 
 import numpy as np
 import pytest
 
-from gyro.cli import main
+from tests.conftest import run_cli
 
 
-def gyro(*args):
-    out, err = io.StringIO(), io.StringIO()
-    with redirect_stdout(out), redirect_stderr(err):
-        try:
-            rc = main(list(args))
-        except SystemExit as exc:  # argparse's own usage errors
-            rc = exc.code
-    return rc, out.getvalue(), err.getvalue()
+gyro = run_cli  # `gyro ARGS` in this process: (exit code, stdout, stderr)
 
 
 def test_json_has_the_contract_keys():

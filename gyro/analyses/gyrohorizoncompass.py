@@ -25,6 +25,7 @@ from dataclasses import replace
 import numpy as np
 
 from gyro.equilibrium import operators
+from gyro.errors import finite_number
 from gyro.kernels import function
 from gyro.models import ParameterError, load
 from gyro.qep import companion_matrix
@@ -52,13 +53,7 @@ def cli_name(name: str) -> str:
 
 
 def _number(name: str, raw) -> float:
-    try:
-        value = float(raw)
-    except (TypeError, ValueError):
-        raise ParameterError(f"parameter {name}: not a number: {raw!r}") from None
-    if not math.isfinite(value):
-        raise ParameterError(f"parameter {name}: must be a finite number, got {raw!r}")
-    return value
+    return finite_number(f"parameter {name}", raw)
 
 
 def _check(name: str, value: float) -> None:

@@ -16,11 +16,10 @@ anything is computed; bad input exits with 2 and one line naming it.
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 from gyro.cli.common import add_json, add_set, check_png_out, parse_sets
-from gyro.errors import ParameterError
+from gyro.errors import ParameterError, finite_number
 
 ORDER = 50
 MAX_POINTS = 10**6  # time points: 8 MB a coordinate
@@ -49,16 +48,6 @@ def _initial_params() -> list:
     from gyro.models import Param
 
     return [Param(n, u, d, desc, "real", (None, None)) for n, (u, d, desc) in INITIAL.items()]
-
-
-def _number(name: str, raw: str) -> float:
-    try:
-        value = float(raw)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name}: not a number: {raw!r}") from None
-    if not math.isfinite(value):
-        raise ParameterError(f"{name}: must be a finite number, got {raw!r}")
-    return value
 
 
 def parse(args):
@@ -100,7 +89,7 @@ def parse(args):
 def _times(args):
     import numpy as np
 
-    t_end = _number("--t-end", args.t_end)
+    t_end = finite_number("--t-end", args.t_end)
     if not t_end > 0:
         raise ParameterError(f"--t-end must be positive, got {args.t_end!r}")
     try:
@@ -123,7 +112,7 @@ def _run_ghc(args) -> int:
         parts = args.perturb.split(",")
         if len(parts) != 4:
             raise ParameterError(f"--perturb: expected four numbers D1,D2,D3,D4, got {args.perturb!r}")
-        perturb = [_number(f"--perturb {n}", p) for n, p in zip(("alpha", "beta", "gamma", "epsilon"), parts)]
+        perturb = [finite_number(f"--perturb {n}", p) for n, p in zip(("alpha", "beta", "gamma", "epsilon"), parts)]
     t = _times(args)
     method = args.method or "DOP853"
     if method not in ghc.METHODS:

@@ -41,8 +41,3 @@ def get(name: str):
     """The module of one method."""
     mod = {n: m for m, (n, _) in _declared().items()}[name]
     return importlib.import_module(f"{__name__}.{mod}")
-
-
-def registry() -> dict:
-    """NAME -> module, in the order of the ladder."""
-    return {n: get(n) for n in names()}

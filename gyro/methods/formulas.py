@@ -30,7 +30,7 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None) -> Spectrum:
     if kernel is not None:
         with np.errstate(all="ignore"):
             f, e = kernel(P)
-        return Spectrum("formulas", f, np.zeros(f.shape), e)
+        return Spectrum("formulas", f, np.zeros(f.shape), e, growth_known=False)
     if P.shape[0] > CHUNK:  # cache-sized pieces: the selection is memory-bound
         return Spectrum.concat([solve(model, P[s]) for s in chunks(P.shape[0], CHUNK)])
     with np.errstate(all="ignore"):
@@ -46,4 +46,4 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None) -> Spectrum:
     e = np.where(np.isfinite(f) & (f > 0), e, np.inf)  # a formula outside its domain (0/0)
     order = np.argsort(f, axis=1, kind="stable")  # as the C's insertion sort: ties keep their order
     f, e = np.take_along_axis(f, order, 1), np.take_along_axis(e, order, 1)
-    return Spectrum("formulas", f, np.zeros(f.shape), e)
+    return Spectrum("formulas", f, np.zeros(f.shape), e, growth_known=False)

@@ -1,0 +1,27 @@
+"""Result objects: what an analysis returns. Each turns into the command line's JSON (the
+keys of the contract), saves and loads itself, concatenates over batches, pickles (plain
+dataclasses of arrays) and plots itself. Results are leaves: they import no analysis.
+One module per kind of result; every name is importable from `gyro.results`.
+
+- `spectrum`: `Spectrum` (a frequency method over a batch), `Stability` and `classify`,
+  `ModalResult` (one set's frequencies with its equilibrium), `nearest_error`;
+- `campbell`: `CampbellDiagram` (frequencies against spin, formulas overlaid);
+- `stability_map`: `StabilityMap` (stability of the equilibrium over two parameters);
+- `sweep`: `FrequencySweep` (frequencies against any one parameter);
+- `trajectory`: `Trajectory` (the gimbal's motion: closed form or an integrator);
+- `gyrohorizoncompass`: `EquilibriumStability`, `ConditionMap`, `AngleTrajectory`;
+- `_io`: atomic saving of arrays and figures, shared by all.
+"""
+from __future__ import annotations
+
+from gyro.results._io import TMP_TAG, save_figure
+from gyro.results.campbell import FORMULA_BAD, CampbellDiagram
+from gyro.results.gyrohorizoncompass import AngleTrajectory, ConditionMap, EquilibriumStability
+from gyro.results.spectrum import ModalResult, Spectrum, Stability, classify, nearest_error
+from gyro.results.stability_map import StabilityMap
+from gyro.results.sweep import FrequencySweep
+from gyro.results.trajectory import Trajectory
+
+__all__ = ["TMP_TAG", "save_figure", "FORMULA_BAD", "CampbellDiagram", "AngleTrajectory", "ConditionMap",
+           "EquilibriumStability", "ModalResult", "Spectrum", "Stability", "classify", "nearest_error",
+           "StabilityMap", "FrequencySweep", "Trajectory"]

@@ -1,0 +1,115 @@
+"""What every result shares: atomic saving (npz, figures), JSON-ready values, table rows."""
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import fields, is_dataclass
+from pathlib import Path
+
+import numpy as np
+
+def _save_npz(obj, path) -> None:
+    """Every field of a dataclass of arrays and scalars into one .npz (objects as JSON)."""
+    data = {}
+    for f in fields(obj):
+        v = getattr(obj, f.name)
+        if isinstance(v, np.ndarray) and v.dtype != object:
+            data[f.name] = v
+        else:
+            data[f.name] = np.array(json.dumps(_jsonable(v)))
+    path = Path(path)
+    _clean_stale(path)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}{TMP_TAG}")
+    try:
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **data)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def _load_npz(cls, path):
+    with np.load(path, allow_pickle=False) as z:
+        kw = {}
+        for f in fields(cls):
+            if f.name not in z:
+                continue
+            v = z[f.name]
+            kw[f.name] = json.loads(v.item()) if v.dtype.kind == "U" else v
+    return cls(**kw)
+
+
+
+
+def _jsonable(v):
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    if isinstance(v, (np.floating, np.integer)):
+        return v.item()
+    if is_dataclass(v) and not isinstance(v, type):
+        return {f.name: _jsonable(getattr(v, f.name)) for f in fields(v)}
+    return v
+
+
+TMP_TAG = ".gyro-tmp"  # temporaries beside an output: .<name>.<pid>.gyro-tmp<suffix>
+
+
+def _clean_stale(out: Path) -> None:
+    """Remove temporaries that a killed run left beside `out` (their process is gone)."""
+    for tmp in out.parent.glob(f".{out.name}.*{TMP_TAG}*"):
+        try:
+            pid = int(tmp.name[len(out.name) + 2:].split(".", 1)[0])
+            os.kill(pid, 0)  # alive: a concurrent run's, left alone
+        except (ValueError, ProcessLookupError):
+            tmp.unlink(missing_ok=True)
+        except PermissionError:
+            pass
+
+
+def _shown_rows(n: int):
+    """The rows a text table of a motion shows: all up to 21, else 11 spread evenly."""
+    return range(n) if n <= 21 else np.unique(np.linspace(0, n - 1, 11).round().astype(int))
+
+
+def _more_rows(n: int) -> list[str]:
+    return [f"({n} points; 11 shown; --json prints all)"] if n > 21 else []
+
+
+def save_figure(fig, out) -> None:
+    """A figure written atomically: a temporary file in the same folder, renamed. A failed
+    run leaves nothing half-written; a killed one leaves a temporary named after the output
+    and its process, which the next run that writes the same output removes."""
+    out = Path(out)
+    _clean_stale(out)
+    tmp = out.with_name(f".{out.name}.{os.getpid()}{TMP_TAG}{out.suffix or '.png'}")
+    try:
+        fig.savefig(tmp, dpi=130)
+        os.replace(tmp, out)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+
+
+def _edges(v: np.ndarray, log: bool) -> np.ndarray:
+    """Cell edges around grid points: midpoints, geometric ones on a log axis."""
+    u = np.log(v) if log else v
+    mid = (u[1:] + u[:-1]) / 2
+    e = np.concatenate([[2 * u[0] - mid[0]], mid, [2 * u[-1] - mid[-1]]])
+    return np.exp(e) if log else e
+
+
+
+def _finite_or_none(a) -> list:
+    """Rows of numbers for strict JSON: a value that could not be computed is null."""
+    return [[float(v) if np.isfinite(v) else None for v in row] for row in np.asarray(a, float)]
+

@@ -1,0 +1,206 @@
+"""The gyrohorizoncompass: one relative equilibrium's stability, the condition maps and a
+motion in its angles."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gyro.results._io import (_edges, _load_npz, _more_rows, _pyplot, _save_npz, _shown_rows,
+                               save_figure)
+
+
+@dataclass
+class EquilibriumStability:
+    """The relative equilibrium of one parameter set: its conditions (margins, > 0 when
+    satisfied), whether the sufficient one holds, and the spectrum of the linearisation."""
+
+    model: str
+    title: str
+    params: dict  # command-line names
+    equilibrium: dict
+    theta: float
+    chi: float
+    conditions: dict  # name -> margin
+    sufficient: bool
+    orbit: bool
+    eigenvalues: np.ndarray  # (2n, 2): re, im
+    spectrally_stable: bool
+
+    def to_dict(self) -> dict:
+        """The `gyro stability --json` document (its keys are the contract)."""
+        return {"model": self.model, "params": dict(self.params), "equilibrium": dict(self.equilibrium),
+                "theta": float(self.theta), "chi": float(self.chi),
+                "conditions": {k: float(v) for k, v in self.conditions.items()},
+                "sufficient": bool(self.sufficient),
+                "eigenvalues": [[float(a), float(b)] for a, b in np.asarray(self.eigenvalues)],
+                "spectrally_stable": bool(self.spectrally_stable)}
+
+    @property
+    def gyroscopically_stabilised(self) -> bool:
+        return self.spectrally_stable and not self.sufficient
+
+    def table(self) -> str:
+        which = "(4.3)" if self.orbit else "(3.6)"
+        lines = [f"{self.title} ({self.model})",
+                 "parameters: " + ", ".join(f"{k} = {v:.6g}" for k, v in self.params.items()),
+                 "relative equilibrium (3.1): alpha = beta = gamma = 0, "
+                 f"epsilon0 = {self.equilibrium['epsilon0']:.9g} rad",
+                 f"theta = (C - A)/I = {self.theta:.6g}, chi = (C - B)/I = {self.chi:.6g}",
+                 f"{'condition (margin > 0 when it holds)':<48} {'margin':>14}"]
+        for k, v in self.conditions.items():
+            lines.append(f"{k:<48} {v:>14.6g}" + ("" if v > 0 else "  fails"))
+        lines.append(f"{'eigenvalues':<22} {'re':>16} {'im':>16}")
+        for re, im in np.asarray(self.eigenvalues):
+            lines.append(f"{'':<22} {re:>16.6g} {im:>16.9g}")
+        verdict = ("stable: the sufficient condition holds" if self.sufficient else
+                   "spectrally stable outside the sufficient condition (gyroscopic stabilisation)"
+                   if self.spectrally_stable else "unstable")
+        lines.append(f"sufficient {which}: {'yes' if self.sufficient else 'no'}; "
+                     f"spectrally stable: {'yes' if self.spectrally_stable else 'no'}; {verdict}")
+        return "\n".join(lines)
+
+    def save(self, path) -> None:
+        _save_npz(self, path)
+
+    @classmethod
+    def load(cls, path) -> "EquilibriumStability":
+        s = _load_npz(cls, path)
+        s.eigenvalues = np.asarray(s.eigenvalues, float)
+        return s
+
+
+@dataclass
+class ConditionMap:
+    """Over a grid of two axes (arrays (y, x)): 2 where the sufficient condition ((3.6), or
+    (4.3) on the orbit) holds, 1 where the linearisation is spectrally stable outside it
+    (gyroscopic stabilisation), 0 where it is unstable."""
+
+    model: str
+    title: str
+    xname: str
+    yname: str
+    x: np.ndarray
+    y: np.ndarray
+    values: np.ndarray  # (y, x) int
+    growth: np.ndarray  # (y, x) largest real part, 1/s (0 when stable)
+    orbit: bool = False
+    base: dict = field(default_factory=dict)  # the other parameters (command-line names)
+
+    KIND = "2: {c} holds, 1: spectrally stable outside {c}, 0: unstable"
+
+    @property
+    def kind(self) -> str:
+        return self.KIND.format(c="(4.3)" if self.orbit else "(3.6)")
+
+    def counts(self) -> dict:
+        v = np.asarray(self.values)
+        return {"sufficient": int(np.sum(v == 2)), "gyroscopic": int(np.sum(v == 1)), "unstable": int(np.sum(v == 0))}
+
+    def to_dict(self) -> dict:
+        """The `gyro map --json` document (its keys are the contract)."""
+        return {"x": {"name": self.xname, "values": np.asarray(self.x).tolist()},
+                "y": {"name": self.yname, "values": np.asarray(self.y).tolist()},
+                "values": np.asarray(self.values).astype(int).tolist(), "kind": self.kind}
+
+    def summary(self, out) -> str:
+        c = self.counts()
+        which = "(4.3)" if self.orbit else "(3.6)"
+        return (f"gyro: wrote {out} ({self.values.size} points: {c['sufficient']} where {which} holds, "
+                f"{c['gyroscopic']} spectrally stable outside it, {c['unstable']} unstable)")
+
+    def save(self, path) -> None:
+        _save_npz(self, path)
+
+    @classmethod
+    def load(cls, path) -> "ConditionMap":
+        m = _load_npz(cls, path)
+        m.values = np.asarray(m.values, int)
+        return m
+
+    def plot(self, out) -> None:
+        plt = _pyplot()
+        from matplotlib.colors import ListedColormap
+
+        which = "(4.3)" if self.orbit else "(3.6)"
+        colors = ["#f2b8b0", "#f3e3a1", "#cfe8cf"]
+        names = ["unstable", f"spectrally stable outside {which} (gyroscopic stabilisation)", f"{which} holds"]
+        fig, ax = plt.subplots(figsize=(7.5, 5.8), layout="constrained")
+        ax.pcolormesh(_edges(np.asarray(self.x), False), _edges(np.asarray(self.y), False), self.values,
+                      cmap=ListedColormap(colors), vmin=-0.5, vmax=2.5, shading="flat")
+        for code in (2, 1, 0):
+            if np.any(self.values == code):
+                ax.fill_between([], [], color=colors[code], label=f"{names[code]}: {int(np.sum(self.values == code))}")
+        ax.set_xlim(_edges(np.asarray(self.x), False)[[0, -1]])
+        ax.set_ylim(_edges(np.asarray(self.y), False)[[0, -1]])
+        ax.set_xlabel(self.xname)
+        ax.set_ylabel(self.yname)
+        fixed = ", ".join(f"{k} = {v:.3g}" for k, v in self.base.items() if k not in ("theta", "chi"))
+        ax.set_title(f"{self.title}: {which} against the spectrum\n({fixed})", fontsize=8)
+        ax.legend(fontsize=8, loc="best")
+        save_figure(fig, out)
+        plt.close(fig)
+
+
+@dataclass
+class AngleTrajectory:
+    """A motion in the model's coordinates (the gyrohorizoncompass's alpha, beta, gamma,
+    epsilon) at the times t, with the integral E along it."""
+
+    model: str
+    title: str
+    method: str
+    t: np.ndarray
+    coordinates: tuple
+    q: np.ndarray  # (len(t), len(coordinates))
+    E: np.ndarray  # (len(t),)
+    params: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """The `gyro simulate --json` document (its keys are the contract)."""
+        d = {"t": np.asarray(self.t).tolist()}
+        for k, name in enumerate(self.coordinates):
+            d[name] = np.asarray(self.q)[:, k].tolist()
+        d["E"] = np.asarray(self.E).tolist()
+        d["method"] = self.method
+        return d
+
+    @property
+    def drift(self) -> float:
+        """max |E - E(0)| / |E(0)| along the motion."""
+        E = np.asarray(self.E)
+        return float(np.max(np.abs(E - E[0])) / abs(E[0])) if E[0] != 0 else float(np.max(np.abs(E - E[0])))
+
+    def table(self) -> str:
+        t, q = np.asarray(self.t), np.asarray(self.q)
+        lines = [f"{self.title} ({self.model}), method {self.method}",
+                 f"E(0) = {self.E[0]:.12g}; max |E - E(0)|/|E(0)| = {self.drift:.2g}"]
+        lines.append(f"{'t [s]':>12}" + "".join(f"{n + ' [rad]':>18}" for n in self.coordinates))
+        for i in _shown_rows(len(t)):
+            lines.append(f"{t[i]:>12.6g}" + "".join(f"{v:>18.11g}" for v in q[i]))
+        return "\n".join(lines + _more_rows(len(t)))
+
+    def save(self, path) -> None:
+        _save_npz(self, path)
+
+    @classmethod
+    def load(cls, path) -> "AngleTrajectory":
+        tr = _load_npz(cls, path)
+        tr.coordinates = tuple(tr.coordinates)
+        return tr
+
+    def plot(self, out) -> None:
+        plt = _pyplot()
+        n = len(self.coordinates)
+        fig, axes = plt.subplots(n + 1, 1, sharex=True, figsize=(7, 1.6 * (n + 1)))
+        for k, (ax, name) in enumerate(zip(axes, self.coordinates)):
+            ax.plot(self.t, np.asarray(self.q)[:, k], lw=1)
+            ax.set_ylabel(f"{name} [rad]")
+        E = np.asarray(self.E)
+        axes[-1].plot(self.t, E - E[0], lw=1)
+        axes[-1].set_ylabel("E - E(0)")
+        axes[0].set_title(f"{self.title}, {self.method}", fontsize=9)
+        axes[-1].set_xlabel("t [s]")
+        fig.tight_layout()
+        save_figure(fig, out)
+        plt.close(fig)

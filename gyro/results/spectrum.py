@@ -1,0 +1,177 @@
+"""Spectra: a frequency method over a batch, the stability verdict read from it, one set's
+modal result, and the distance of approximate frequencies to exact ones."""
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from gyro.results._io import _load_npz, _pyplot, _save_npz
+
+
+@dataclass
+class Spectrum:
+    """The result of one frequency method over a batch: arrays of shape (sets, modes)."""
+
+    method: str
+    frequencies: np.ndarray  # rad/s, ascending per set
+    growth: np.ndarray  # real parts of the eigenvalues (> 0: growing), same order
+    error_estimate: np.ndarray  # relative error bound per frequency
+    equilibrium: np.ndarray | None = None  # (sets, equilibrium coordinates)
+    route: np.ndarray = field(default=None)  # per set: which rung answered (default only)
+    growth_known: bool = True  # False for a method that computes no growth rates (formulas)
+
+    def __len__(self) -> int:
+        return self.frequencies.shape[0]
+
+    @classmethod
+    def concat(cls, parts: list["Spectrum"]) -> "Spectrum":
+        """One spectrum of the sets of several, in order."""
+        cat = {f: (None if getattr(parts[0], f) is None else np.concatenate([getattr(x, f) for x in parts]))
+               for f in ("frequencies", "growth", "error_estimate", "equilibrium", "route")}
+        return cls(parts[0].method, **cat, growth_known=all(p.growth_known for p in parts))
+
+    def to_dict(self, k: int, model, params: dict) -> dict:
+        """The `gyro frequencies --json` document of set k (its keys are the contract)."""
+        stab = classify(self)
+        eq = (None if self.equilibrium is None else
+              dict(zip(model.meta["equilibrium_coordinates"], map(float, self.equilibrium[k]))))
+        return {
+            "model": model.name,
+            "params": params,
+            "frequencies": [float(w) for w in self.frequencies[k]],
+            "equilibrium": eq,
+            "eigenvalues_re": [float(g) for g in self.growth[k]],
+            "method": self.method,
+            "error_estimate": [float(e) if np.isfinite(e) else None for e in self.error_estimate[k]],
+            "stability": {"class": str(stab.label[k]), "growth_rate": float(stab.growth_rate[k]),
+                          "unstable_roots": int(stab.unstable_roots[k])},
+        }
+
+    def table(self, k: int, model) -> str:
+        """The `gyro frequencies` text of set k."""
+        freqs, est = self.frequencies[k], self.error_estimate[k]
+        stab = classify(self)
+        lines = [f"{model.meta['title']} ({model.name})",
+                 f"natural frequencies by the method '{self.method}'"
+                 + (f" (answered by its {self.route[k]} rung)" if self.route is not None else "") + ":",
+                 f"{'':>4} {'omega [rad/s]':>16} {'f [Hz]':>14} {'period [s]':>14} {'rel. error <=':>14}"]
+        lam = np.abs(self.growth[k] + 1j * freqs)
+        grows = (self.growth[k] > np.maximum(np.where(np.isfinite(est), est, np.inf), 1e-9) * lam) & np.isfinite(est)
+        for i, (w, e) in enumerate(zip(freqs, est), 1):
+            period = 2 * np.pi / w if w > 0 else float("inf")
+            row = f"{i:>4} {w:>16.9g} {w / (2 * np.pi):>14.6g} {period:>14.6g} {e:>14.2g}"
+            if grows[i - 1]:
+                row += f"   grows at {self.growth[k][i - 1]:.6g} 1/s"
+            lines.append(row)
+        label = stab.label[k]
+        note = {"unstable": f", {stab.unstable_roots[k]} growing root(s), the fastest at {stab.growth_rate[k]:.6g} 1/s",
+                "unknown": (f" (the method '{self.method}' computes no growth rates: no verdict; try --method "
+                            "default)" if not self.growth_known else
+                            " (a root's error is unbounded: this method cannot tell; try --method default)"),
+                "failed": " (these parameters could not be computed)"}.get(label, "")
+        lines.append(f"equilibrium: {label}{note}")
+        return "\n".join(lines)
+
+    def save(self, path) -> None:
+        _save_npz(self, path)
+
+    @classmethod
+    def load(cls, path) -> "Spectrum":
+        s = _load_npz(cls, path)
+        if isinstance(s.route, list):
+            s.route = np.array(s.route, dtype=object)
+        return s
+
+    def plot(self, x=None, ax=None, label=None):
+        """Frequencies of every set against x (the set index by default), one curve a mode."""
+        plt = _pyplot()
+        if ax is None:
+            _, ax = plt.subplots(layout="constrained")
+        x = np.arange(len(self)) if x is None else x
+        for j in range(self.frequencies.shape[1]):
+            ax.plot(x, self.frequencies[:, j], lw=1, color="k", label=(label or self.method) if j == 0 else None)
+        ax.set_yscale("log")
+        ax.set_ylabel("natural frequency omega [rad/s]")
+        return ax
+
+
+@dataclass
+class Stability:
+    """Per set: 'stable', 'unstable' (with its growth rate, 1/s), 'marginal' (a root whose
+    real part, or whose frequency, is zero only within its error estimate), 'unknown' (a
+    root's error is unbounded) or 'failed' (the set could not be computed)."""
+
+    label: np.ndarray  # (sets,) str
+    growth_rate: np.ndarray  # (sets,) largest real part, 1/s (0 when stable)
+    unstable_roots: np.ndarray  # (sets,) int: growing modes (eigenvalue pairs, or quadruples, with a growing member)
+    slowest_growth: np.ndarray  # (sets,) smallest growing real part, 1/s (0 when stable)
+
+
+def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
+    """Stability of each set's equilibrium from its spectrum.
+
+    A root grows when its real part exceeds what its error allows: max(estimate, rel)
+    times |lambda| (the conservative gyroscopic spectrum lies on the imaginary axis, so a
+    real part within rounding of it is noise). A root with |lambda| within its own error of
+    zero (estimate >= 1: a neutral direction, omega1 at the pole or without Earth rate) is
+    marginal, and so is an exact zero root. A method that computes no growth rates (the
+    formulas: Spectrum.growth_known) gives no verdict ('unknown'). No verdict without a bound: a set with a frequency or growth rate that is not
+    finite is 'failed' (it could not be computed), and one where a root's error is
+    unbounded (infinite or NaN: a method that lost a root, as polyroots does) is 'unknown',
+    unless a root with a bounded error grows, which makes it 'unstable' all the same."""
+    lam = np.abs(spec.growth + 1j * spec.frequencies)
+    est = np.asarray(spec.error_estimate, dtype=float)
+    bounded = np.isfinite(est)
+    allow = np.maximum(np.where(bounded, est, np.inf), rel) * lam
+    # a root resolved from zero has a relative error below 1/2; one that is not (a rounded
+    # split of a double zero root, 3e-20 with an error of 0.95) shows no growth, and it is
+    # neutral, as is an exact zero root (lambda = 0: a free direction)
+    resolved = bounded & (est < 0.5)
+    growing = (spec.growth > allow) & resolved
+    neutral = bounded & ~resolved | (lam == 0)
+    failed = ~np.all(np.isfinite(spec.frequencies) & np.isfinite(spec.growth), axis=1)
+    unknown = ~np.all(bounded, axis=1)
+    if not spec.growth_known:  # the formulas assume a stable gyrocompass: no growth rates
+        unknown = np.ones(len(lam), bool)
+    label = np.where(failed, "failed", np.where(
+        growing.any(axis=1), "unstable", np.where(
+            unknown, "unknown", np.where(neutral.any(axis=1), "marginal", "stable"))))
+    rate = np.where(growing, spec.growth, 0.0).max(axis=1)
+    slowest = np.where(growing, spec.growth, np.inf).min(axis=1)
+    return Stability(label.astype(object), rate, growing.sum(axis=1), np.where(np.isfinite(slowest), slowest, 0.0))
+
+
+@dataclass
+class ModalResult:
+    """Natural frequencies of a model at one parameter set, with the equilibrium used."""
+
+    model: str
+    params: dict
+    equilibrium: dict
+    frequencies: list  # rad/s, ascending
+    eigenvalues_re: list = field(default_factory=list)  # real parts, same order (growth if > 0)
+    error_estimate: list = field(default_factory=list)  # last Newton step, relative
+
+    def to_json(self) -> str:
+        return json.dumps(asdict(self), indent=1)
+
+    def save(self, path) -> None:
+        with open(path, "w") as fh:
+            fh.write(self.to_json())
+
+    @classmethod
+    def load(cls, path) -> "ModalResult":
+        with open(path) as fh:
+            return cls(**json.load(fh))
+
+
+# --------------------------------------------------------------------------- sweeps
+
+
+def nearest_error(approx: np.ndarray, exact: np.ndarray) -> np.ndarray:
+    """Relative distance of each approximate frequency to the nearest exact one."""
+    with np.errstate(all="ignore"):
+        return np.min(np.abs(approx[:, :, None] / exact[:, None, :] - 1), axis=2)
+

@@ -107,21 +107,35 @@ def test_a_gyroscopically_stabilised_motion_stays_small():
 
 
 def test_the_gyroscopically_stabilised_cases_are_counted():
-    """The counts docs/gyrohorizoncompass.md gives (README's maps, laboratory set)."""
+    """The counts docs/gyrohorizoncompass.md gives (README's maps, laboratory set), from the
+    flagged maps: a boundary point (rounding could change its verdict) is counted as none
+    of the others. In (theta, chi) the row chi = 0.32 lies exactly on the fourth condition
+    of (3.6), (1 - 3 chi) nu^2 - eta^2 = 0: det C1 = 0 and a defective zero root, so every
+    point of it is a boundary but those with a growing root well off the axis (certainly
+    unstable). Off the row, 1 and 199 points are stabilised."""
     base = ghc.parameters({k: LAB[k] for k in BASE_KEYS}, need_equilibrium=False)
     m = ghc.condition_map(dict(base), ("zeta", 0.01, 0.9, 90), ("eta", 0.0, 1.2, 121))
-    assert m.counts() == {"sufficient": 5498, "gyroscopic": 119, "unstable": 5273}
+    assert m.counts() == {"sufficient": 5498, "gyroscopic": 119, "unstable": 5273, "boundary": 0}
     # the strip: eta above sqrt(1 - 3 chi) nu (both blocks of C1 indefinite), below 0.96
     yy = np.broadcast_to(m.y[:, None], m.values.shape)[m.values == 1]
     assert yy.min() > math.sqrt(1 - 3 * 0.05) and yy.max() < 0.96
     base = ghc.parameters({**LAB}, need_equilibrium=False)
     m = ghc.condition_map(dict(base), ("theta", -0.5, 0.6, 111), ("chi", -0.5, 0.6, 111))
-    assert m.counts() == {"sufficient": 6068, "gyroscopic": 6, "unstable": 6247}
+    assert m.counts() == {"sufficient": 6068, "gyroscopic": 1, "unstable": 6173, "boundary": 79}
+    rows = np.unique(np.nonzero(m.boundary)[0])
+    assert rows.tolist() == [82] and math.isclose(m.y[82], 0.32, rel_tol=1e-15)
+    assert np.all(m.values[82][~m.boundary[82]] == 0)  # the rest of the row: certainly unstable
     m = ghc.condition_map(dict(base), ("theta", 0.2, 0.32, 121), ("chi", 0.3, 0.36, 61))
-    assert m.counts() == {"sufficient": 740, "gyroscopic": 248, "unstable": 6393}
-    # the wedge at the corner of the (3.6) rectangle theta < 0.2367, chi < 0.32
+    assert m.counts() == {"sufficient": 740, "gyroscopic": 199, "unstable": 6356, "boundary": 86}
+    assert np.unique(np.nonzero(m.boundary)[0]).tolist() == [20]  # chi = 0.32
+    # the wedge at the corner of the (3.6) rectangle theta < 0.2367, chi < 0.32: grid points
+    # theta 0.237 to 0.269, chi 0.321 to 0.340
     th, ch = (np.broadcast_to(a, m.values.shape)[m.values == 1] for a in (m.x[None, :], m.y[:, None]))
-    assert 0.2367 < th.min() and th.max() < 0.29 and 0.32 <= ch.min() and ch.max() < 0.345
+    assert np.isclose(th.min(), 0.237) and np.isclose(th.max(), 0.269)
+    assert np.isclose(ch.min(), 0.321) and np.isclose(ch.max(), 0.340)
+    # the smallest growth of a certainly unstable point: far above rounding (the growth of
+    # 1e-8 on the row was the square root of rounding, a defective zero root's splitting)
+    assert m.growth[m.values == 0].min() > 4e-3
 
 
 BASE_KEYS = ("A", "B", "C", "J", "L", "I", "nu")
@@ -135,7 +149,8 @@ def test_stability_json_has_the_contract_keys():
     assert rc == 0, err
     d = json.loads(out)
     assert set(d) == {"model", "params", "equilibrium", "theta", "chi", "conditions", "sufficient",
-                      "eigenvalues", "spectrally_stable"}
+                      "eigenvalues", "spectrally_stable", "boundary", "boundary_reason", "verdict"}
+    assert d["boundary"] is False and d["boundary_reason"] is None and d["verdict"] == "stable"
     assert d["model"] == "gyrohorizoncompass"
     assert set(d["params"]) == {"A", "B", "C", "J", "L", "I", "nu", "zeta", "eta", "lambda"}
     assert math.isclose(d["params"]["lambda"], 1.05, rel_tol=1e-14)  # 1 + chi by default
@@ -220,10 +235,11 @@ def test_map_json_and_figure(tmp_path):
                        "--out", str(out), "--json")
     assert rc == 0, err
     d = json.loads(so)
-    assert set(d) == {"x", "y", "values", "kind"}
+    assert set(d) == {"x", "y", "values", "kind", "boundary"}
     assert d["x"]["name"] == "zeta" and len(d["x"]["values"]) == 9 and len(d["y"]["values"]) == 11
     v = np.array(d["values"])
     assert v.shape == (11, 9) and set(np.unique(v)) <= {0, 1, 2}
+    assert np.array(d["boundary"]).shape == (11, 9) and not np.any(d["boundary"])
     assert "(3.6)" in d["kind"]
     assert out.stat().st_size > 1000
     # 2 exactly where (3.6) holds: (1 - 3 theta) - zeta^2 - eta^2 > 0 and (1 - 3 chi) - eta^2 > 0

@@ -276,6 +276,31 @@ def sylvester_minors(C1):
     return [M[:k, :k].det() for k in range(1, 5)]
 
 
+def rounding_scale(margin):
+    """k * sum |t| over the terms t of a margin expanded as a Laurent polynomial in the
+    parameters, k = 2 d + N (d the largest number of factors in a term, N the number of
+    terms): times the unit roundoff u it bounds, to first order in u, how far the margin
+    computed in floating point from inputs rounded to double can lie from its exact value
+    at the given decimal inputs (docs/gyrohorizoncompass.md, "Boundaries"). Each term
+    t = c p1^k1 ... carries at most d input roundings (1 + delta_i, |delta_i| <= u, one per
+    factor) and d - 1 product roundings; a sum of N terms adds at most N - 1 more. Every
+    parameter is positive except eta, which must occur to even powers only, so |t| is the
+    term with |c| for c and needs no Abs."""
+    terms = sp.Add.make_args(sp.expand(margin))
+    degree, total = 0, sp.Integer(0)
+    for t in terms:
+        c, mono = t.as_coeff_Mul()
+        powers = {} if mono == 1 else mono.as_powers_dict()
+        for base, k in powers.items():
+            if not (base.is_Symbol and k.is_Integer and base in P.values()):
+                raise ValueError(f"rounding_scale: {t} is not a monomial in the parameters")
+            if base == eta and k % 2:
+                raise ValueError(f"rounding_scale: odd power of eta in {t}")
+        degree = max(degree, sum(abs(int(k)) for k in powers.values()))
+        total += abs(c) * mono
+    return (2 * degree + len(terms)) * total
+
+
 # ----------------------------------------------------------------------------- quantities
 
 
@@ -311,6 +336,13 @@ def quantities():
                                  "in the order alpha, gamma, beta, epsilon; the conditions (3.6) as "
                                  "printed (zeta for xi); the satellite conditions (4.3) with "
                                  "chi < lambda/4 (zeta = nu, eta = 0)."),
+        "condition_rounding": (["params"],
+                               [("sylvester", sp.Matrix([rounding_scale(m) for m in sylvester_minors(C1)])),
+                                ("printed_36", sp.Matrix([rounding_scale(m) for m in conditions_36()])),
+                                ("satellite_43", sp.Matrix([rounding_scale(m) for m in conditions_43()]))],
+                               "Rounding bounds of the margins of `stability_conditions`, over the "
+                               "unit roundoff: u times each bounds how far the computed margin can "
+                               "lie from the exact one at the decimal inputs (first order in u)."),
     }
 
 

@@ -11,7 +11,12 @@ The spectrum: the eigenvalues of the companion matrix [[0, I], [-M^-1 K, -M^-1 D
 emitted operator at (0, 0, 0, epsilon0) (LAPACK, balanced; gyro.qep.companion_matrix). The
 ladder's default method assumes gyroscopic blocks with K > 0, which fails exactly where this
 module looks (gyroscopic stabilisation, K indefinite), so the companion eigensolve is used
-throughout. Spectrally stable: no eigenvalue with real part above 1e-9 |eig|max.
+throughout. Each eigenvalue carries an error radius (`eigen_radii`: its condition number
+times a bound on the rounding of the companion matrix), and each condition's margin a
+rounding bound (the emitted `condition_rounding`); the verdicts are read through
+gyro.results.verdict: 'unstable' where a root's disk lies right of the axis, 'boundary'
+where two disks overlap or a margin lies within its bound of zero (rounding could change
+the answer), 'stable' otherwise (docs/gyrohorizoncompass.md, "Boundaries").
 
 Names: the command line's `lambda` is the model's `lam` (a keyword of C and Python); its
 default is 1 + chi of the given A, B, C, I (3.2). `theta` = (C - A)/I and `chi` = (C - B)/I
@@ -29,12 +34,14 @@ from gyro.errors import finite_number
 from gyro.kernels import function
 from gyro.models import ParameterError, load
 from gyro.qep import companion_matrix
+from gyro.results import verdict
 
 MODEL = "gyrohorizoncompass"
 CLI_NAMES = {"lambda": "lam"}  # the model file's CLI_NAMES (command line -> model symbol)
 NAMES = ("A", "B", "C", "J", "L", "I", "nu", "zeta", "eta", "lambda")
 DERIVED = ("theta", "chi")  # map axes besides the parameters
-REL = 1e-9  # a real part above REL |eig|max grows
+U = 2.0**-53  # the unit roundoff of double precision
+BOUNDARY, MARGINAL = -1, -2  # condition_map's values besides 2, 1, 0
 LAMBDA_TOL = 1e-12  # lambda = 1 + chi to this relative tolerance when eta != 0
 
 C36 = ("(3.6) 1 + theta", "(3.6) 1/3 - theta", "(3.6) 1 + chi", "(3.6) 1/3 - chi",
@@ -150,21 +157,81 @@ def analyse(P: np.ndarray, orbit: np.ndarray | bool = False) -> dict:
         resid = np.asarray(function(m, "equilibrium_residual")(P, qe)[0]).reshape(n, -1)
         M, D, K = operators(m, P, qe)
         ok = np.isfinite(eps0[:, 0])
-        A = companion_matrix(np.where(ok[:, None, None], M, np.eye(4)), D, K)
+        Mc = np.where(ok[:, None, None] & np.all(np.isfinite(M), axis=(1, 2))[:, None, None], M, np.eye(4))
+        A = companion_matrix(Mc, D, K)
+        ok &= np.all(np.isfinite(A), axis=(1, 2))
         eig = np.full((n, 8), np.nan + 0j)
-        eig[ok] = np.linalg.eigvals(A[ok])
+        radius = np.full((n, 8), np.inf)
+        eig[ok], radius[ok] = eigen_radii(A[ok], Mc[ok])
+        bounds = [U * np.asarray(x).reshape(n, -1) for x in function(m, "condition_rounding")(P)]
     lam = P[:, 9]
     exact = np.abs(lam - (1 + tc[:, 1])) <= LAMBDA_TOL * np.maximum(1.0, np.abs(1 + tc[:, 1]))
     orbit = np.broadcast_to(np.asarray(orbit, bool), (n,))
-    sufficient = np.where(orbit, np.all(c43 > 0, axis=1),
-                          np.where(exact, np.all(c36 > 0, axis=1), np.all(syl > 0, axis=1))) & ok
-    big = np.max(np.abs(eig), axis=1)
+    # the sufficient condition in force at each set, its margins and their rounding bounds
+    which = np.where(orbit, 2, np.where(exact, 1, 0))
+    held, decided, why = (np.empty(n, bool), np.empty(n, bool), np.empty(n, object))
+    for code, marg, bnd, names in ((0, syl, bounds[0], SYLVESTER), (1, c36, bounds[1], C36),
+                                   (2, c43, bounds[2], C43)):
+        rows = which == code
+        if rows.any():
+            held[rows], decided[rows], why[rows] = verdict.condition(marg[rows], bnd[rows], names)
+    sufficient = held & ok
+    spec = verdict.spectrum(eig, radius, conservative=True, exact_zero=free_coordinate(K))
     growth = np.max(eig.real, axis=1)
-    stable = ok & (growth <= REL * big)
+    stable = ok & ((spec.label == "stable") | sufficient)  # C1 > 0 puts the spectrum on the axis
+    # the verdict of the set: (3.6)/(4.3) decided and holding is stable whatever the spectrum;
+    # otherwise the spectrum's, unless the condition is undecided and the spectrum not
+    # certainly unstable (then whether it holds, or the set is only spectrally stable, is
+    # rounding's choice: a boundary)
+    label, reason = spec.label.copy(), spec.reason.copy()
+    label[sufficient] = "stable"
+    reason[sufficient] = None
+    undecided = ok & ~decided & (spec.label != "unstable")
+    label[undecided], reason[undecided] = "boundary", why[undecided]
+    label[~ok], reason[~ok] = "failed", "no relative equilibrium, or an operator that is not finite"
     return {"epsilon0": eps0[:, 0], "exists": margins[:, 0], "theta": tc[:, 0], "chi": tc[:, 1],
             "lambda_is_1_chi": exact,
             "sylvester": syl, "c36": c36, "c43": c43, "sufficient": sufficient, "eigenvalues": eig,
+            "radius": radius, "margin_bounds": bounds, "condition_decided": decided,
+            "spectrum_verdict": spec, "verdict": verdict.make(label, reason),
+            "boundary": label == "boundary",
             "spectrally_stable": stable, "growth": growth, "B1": B1, "C1": C1, "residual": resid}
+
+
+def eigen_radii(A: np.ndarray, M: np.ndarray):
+    """Eigenvalues of a batch of companion matrices A (sets, 2n, 2n) and a radius each that
+    bounds its distance to the exact eigenvalue at the decimal inputs: n_A kappa_i ||E||_2,
+    with kappa_i = ||x_i|| ||y_i|| / |y_i^H x_i| (right and left eigenvectors; the rows of
+    X^-1 are the left ones) and ||E||_2 <= ||E||_F <= u ||A||_F (2 n_A + 3 n_A cond_2(M)):
+    n_A for the rounding of the inputs and of M, D, K (measured: at most 2.4 u ||A||_F
+    against 40 digits, tests/test_verdict.py), n_A for LAPACK's QR iteration (backward
+    error p(n) u ||A||, p(n) ~ n), 3 n_A cond(M) for the two solves with M (LU, growth 1 for
+    M > 0). The factor n_A: every eigenvalue of A + E lies in a disk of radius
+    n_A kappa_i ||E||_2 about some lambda_i (a Bauer-Fike theorem with individual condition
+    numbers, Demmel 1997, Thm 4.5), not only to first order. A defective eigenvalue has
+    kappa = inf: its radius is infinite. docs/gyrohorizoncompass.md, "Boundaries"."""
+    nA = A.shape[-1]
+    with np.errstate(all="ignore"):
+        w, X = np.linalg.eig(A)
+        kappa = np.full(w.shape, np.inf)
+        try:
+            kappa[:] = np.linalg.norm(X, axis=1) * np.linalg.norm(np.linalg.inv(X), axis=2)
+        except np.linalg.LinAlgError:  # an exactly singular X somewhere: set by set
+            for k in range(len(A)):
+                try:
+                    kappa[k] = np.linalg.norm(X[k], axis=0) * np.linalg.norm(np.linalg.inv(X[k]), axis=1)
+                except np.linalg.LinAlgError:
+                    continue
+        E = U * np.linalg.norm(A, axis=(1, 2)) * (2 * nA + 3 * nA * np.linalg.cond(M))
+        radius = nA * np.where(np.isfinite(kappa), kappa, np.inf) * E[:, None]
+    return w, np.where(np.isfinite(radius), radius, np.inf)
+
+
+def free_coordinate(K: np.ndarray) -> np.ndarray:
+    """Per set: the stiffness has an exactly zero row and column (a coordinate that no
+    restoring moment holds, as alpha at zeta = 0): its zero root is exact, not rounding's."""
+    z = np.all(K == 0, axis=2) & np.all(K == 0, axis=1)
+    return np.any(z, axis=1)
 
 
 def stability(values: dict, orbit: bool = False):
@@ -182,9 +249,19 @@ def stability(values: dict, orbit: bool = False):
     if orbit or on_orbit(values):
         conditions.update(zip(C43, map(float, a["c43"][0])))
     conditions.update(zip(SYLVESTER, map(float, a["sylvester"][0])))
-    eig = a["eigenvalues"][0]
-    eig = eig[np.lexsort((eig.real, eig.imag))]
+    bounds = {}
+    if a["lambda_is_1_chi"][0]:
+        bounds.update(zip(C36, map(float, a["margin_bounds"][1][0])))
+    if orbit or on_orbit(values):
+        bounds.update(zip(C43, map(float, a["margin_bounds"][2][0])))
+    bounds.update(zip(SYLVESTER, map(float, a["margin_bounds"][0][0])))
+    eig, radii = a["eigenvalues"][0], a["radius"][0]
+    order = np.lexsort((eig.real, eig.imag))
+    eig, radii = eig[order], radii[order]
+    v = a["verdict"]
     return EquilibriumStability(
+        verdict=str(v.label[0]), boundary_reason=v.reason[0] if v.label[0] in ("boundary", "marginal") else None,
+        margin_bounds=bounds, radii=radii,
         model=MODEL, title=m.meta["title"], params=cli_params(values),
         equilibrium={"alpha": 0.0, "beta": 0.0, "gamma": 0.0, "epsilon0": float(a["epsilon0"][0])},
         theta=float(a["theta"][0]), chi=float(a["chi"][0]), conditions=conditions,
@@ -234,7 +311,8 @@ def condition_map(base: dict, xaxis, yaxis, orbit: bool = False, lambda_follows:
     """The (3.6) region, the spectrally stable one and the unstable one over a grid of two
     axes ((name, lo, hi, n) each: parameters or theta, chi), lambda following 1 + chi when
     `lambda_follows` (and lambda is no axis). Values: 2 where the sufficient condition holds, 1 spectrally stable
-    outside it, 0 unstable. Every grid point is checked first (ParameterError naming the
+    outside it, 0 unstable, -1 (BOUNDARY) where rounding could change the verdict, -2
+    (MARGINAL) an exact zero root. Every grid point is checked first (ParameterError naming the
     axis value where a parameter is out of range or there is no equilibrium)."""
     from gyro.results import ConditionMap
 
@@ -263,8 +341,11 @@ def condition_map(base: dict, xaxis, yaxis, orbit: bool = False, lambda_follows:
                 raise ParameterError(f"{exc} ({where})") from None
             sets.append(v)
     a = analyse(m.vectors(sets), orbit)
-    values = np.where(a["sufficient"], 2, np.where(a["spectrally_stable"], 1, 0)).reshape(ny, nx)
-    growth = np.maximum(a["growth"], 0.0).reshape(ny, nx)
+    label = a["verdict"].label
+    values = np.select([label == "boundary", label == "marginal", a["sufficient"], label == "stable"],
+                       [BOUNDARY, MARGINAL, 2, 1], 0).reshape(ny, nx)
+    # the growth of a certainly unstable set; 0 elsewhere (a boundary's growth is rounding's)
+    growth = np.where(label == "unstable", np.maximum(a["growth"], 0.0), 0.0).reshape(ny, nx)
     moved = {xn, yn} | {k for k, d in (("A", "theta"), ("B", "chi")) if d in (xn, yn)}
     if lambda_follows:
         moved.add("lambda")
@@ -272,6 +353,8 @@ def condition_map(base: dict, xaxis, yaxis, orbit: bool = False, lambda_follows:
         moved |= {"zeta", "eta"}
     return ConditionMap(model=MODEL, title=m.meta["title"], xname=xn, yname=yn, x=x, y=y,
                         values=values.astype(int), growth=growth, orbit=bool(orbit),
+                        boundary=(label == "boundary").reshape(ny, nx),
+                        reasons=a["verdict"].reason.reshape(ny, nx),
                         base={k: v for k, v in cli_params(base).items() if k not in moved})
 
 

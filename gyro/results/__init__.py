@@ -10,6 +10,8 @@ One module per kind of result; every name is importable from `gyro.results`.
 - `sweep`: `FrequencySweep` (frequencies against any one parameter);
 - `trajectory`: `Trajectory` (the gimbal's motion: closed form or an integrator);
 - `gyrohorizoncompass`: `EquilibriumStability`, `ConditionMap`, `AngleTrajectory`;
+- `verdict`: `Verdict`, the one verdict type (stable, marginal, unstable, boundary,
+  unknown, failed, each with its reason) and the two tests every analysis reads it through;
 - `_io`: atomic saving of arrays and figures, shared by all.
 """
 from __future__ import annotations
@@ -21,7 +23,8 @@ from gyro.results.spectrum import ModalResult, Spectrum, Stability, classify, ne
 from gyro.results.stability_map import StabilityMap
 from gyro.results.sweep import FrequencySweep
 from gyro.results.trajectory import Trajectory
+from gyro.results.verdict import Verdict
 
 __all__ = ["TMP_TAG", "save_figure", "FORMULA_BAD", "CampbellDiagram", "AngleTrajectory", "ConditionMap",
            "EquilibriumStability", "ModalResult", "Spectrum", "Stability", "classify", "nearest_error",
-           "StabilityMap", "FrequencySweep", "Trajectory"]
+           "StabilityMap", "FrequencySweep", "Trajectory", "Verdict"]

@@ -1,0 +1,139 @@
+"""One verdict type for every stability answer of the project: a label per set and, where
+the label is not plainly 'stable' or 'unstable', one line saying why.
+
+The labels:
+
+- ``stable``: certain within the stated bounds (every root simple on the imaginary axis of
+  a conservative system, or a sufficient condition whose margins all exceed their rounding
+  bounds);
+- ``marginal``: a neutral direction found exactly (an exact zero root: a free coordinate);
+- ``unstable``: a root grows by more than its error bound;
+- ``boundary``: rounding could change the verdict (roots merged within their error bounds,
+  a root not resolved from zero, a condition's margin within its rounding bound of zero);
+  never counted as stable or as stabilised;
+- ``unknown``: no bound (a method that lost a root, or computes no growth rates);
+- ``failed``: the set could not be computed.
+
+Two tests do the work, and every analysis reads its verdicts through them:
+`condition` (the margins of a sufficient condition against their rounding bounds) and
+`spectrum` (eigenvalues with error radii: disks that contain the exact roots). Why the
+tests decide what they claim, and where the bounds come from: docs/gyrohorizoncompass.md,
+section "Boundaries: verdicts that rounding could change".
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+LABELS = ("stable", "marginal", "unstable", "boundary", "unknown", "failed")
+EPS = float(np.finfo(float).eps)  # 2 u: the spacing of doubles at 1
+UNIT_ROUNDOFF = EPS / 2  # u
+
+
+@dataclass
+class Verdict:
+    """Per set of a batch: its label (one of LABELS) and a reason (None, or one line)."""
+
+    label: np.ndarray  # (sets,) object: str
+    reason: np.ndarray  # (sets,) object: str or None
+
+    def __len__(self) -> int:
+        return len(self.label)
+
+    @property
+    def boundary(self) -> np.ndarray:
+        return np.asarray(self.label == "boundary", bool)
+
+    def counts(self) -> dict:
+        """{label: number of sets} for the labels present (in the order of LABELS)."""
+        return {k: int(np.sum(self.label == k)) for k in LABELS if np.any(self.label == k)}
+
+
+def make(label, reason=None) -> Verdict:
+    """A Verdict from arrays (or one label and reason)."""
+    label = np.atleast_1d(np.asarray(label, dtype=object))
+    bad = set(label) - set(LABELS)
+    if bad:
+        raise ValueError(f"not a verdict: {sorted(bad)}")
+    reason = np.full(label.shape, None, dtype=object) if reason is None else \
+        np.broadcast_to(np.asarray(reason, dtype=object), label.shape).copy()
+    return Verdict(label, reason)
+
+
+def condition(margin: np.ndarray, bound: np.ndarray, names) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A sufficient condition 'every margin > 0' over a batch: margins (sets, k) with their
+    rounding bounds (sets, k) (|computed - exact| <= bound), names (k,).
+
+    Returns (holds, decided, reason): `holds` where every margin exceeds its bound (the
+    exact margins are all positive), `decided` where it holds or some margin lies below
+    minus its bound (one exact margin is negative, so the condition fails whatever the
+    others are); elsewhere rounding could change the answer, and `reason` names the first
+    margin within its bound of zero."""
+    margin, bound = np.atleast_2d(margin), np.atleast_2d(bound)
+    ok = np.isfinite(margin) & np.isfinite(bound)
+    above = ok & (margin > bound)
+    below = ok & (margin < -bound)
+    holds = np.all(above, axis=1)
+    decided = holds | np.any(below, axis=1)
+    reason = np.full(margin.shape[0], None, dtype=object)
+    for k in np.flatnonzero(~decided):
+        j = int(np.argmax(~above[k] & ~below[k]))
+        reason[k] = (f"the margin {names[j]} = {margin[k, j]:.3g} lies within its rounding bound "
+                     f"{bound[k, j]:.2g} of zero")
+    return holds, decided, reason
+
+
+def spectrum(lam: np.ndarray, radius: np.ndarray, conservative: bool = True,
+             exact_zero: np.ndarray | None = None) -> Verdict:
+    """Verdicts from eigenvalues lam (sets, m) and error radii (sets, m): the exact roots
+    lie in the disks |z - lam| <= radius (radius inf or NaN: unbounded; lam not finite:
+    failed).
+
+    - unstable: some disk lies in Re z > 0 (a root grows whatever rounding did);
+    - boundary: otherwise, two disks overlap (the exact roots may coincide there: a Krein
+      collision, a Jordan block, a zero root with its mirror image);
+    - stable: otherwise, when `conservative` (a Hamiltonian spectrum: an isolated disk that
+      meets the axis holds one root, and its mirror image -conj(z), which must lie in the
+      same disk, is the root itself: it is on the axis); without `conservative` every
+      disk must lie in Re z < 0, a disk that meets the axis being a boundary.
+
+    `exact_zero` (sets,): sets where a zero root is known exactly (a free coordinate);
+    their only overlapping disks being those at zero, they are marginal."""
+    lam, radius = np.atleast_2d(lam), np.atleast_2d(radius)
+    n, m = lam.shape
+    failed = ~np.all(np.isfinite(lam), axis=1)
+    unbounded = ~np.all(np.isfinite(radius), axis=1) & ~failed
+    r = np.where(np.isfinite(radius), radius, np.inf)
+    grows = np.any(lam.real > r, axis=1) & ~failed
+    d = np.abs(lam[:, :, None] - lam[:, None, :])
+    overlap = (d <= r[:, :, None] + r[:, None, :]) & ~np.eye(m, dtype=bool)
+    at_zero = np.abs(lam) <= r
+    merged = np.any(overlap, axis=(1, 2))
+    only_zero = np.all(~overlap | (at_zero[:, :, None] & at_zero[:, None, :]), axis=(1, 2))
+    on_axis = np.any(np.abs(lam.real) <= r, axis=1)
+    label = np.full(n, "stable", dtype=object)
+    reason = np.full(n, None, dtype=object)
+    label[grows] = "unstable"
+    for k in np.flatnonzero(failed | (~grows & (unbounded | merged | (not conservative) & on_axis))):
+        if failed[k]:
+            label[k], reason[k] = "failed", "a root could not be computed"
+        elif grows[k]:
+            label[k] = "unstable"
+        elif unbounded[k]:
+            label[k], reason[k] = "unknown", "a root's error is unbounded"
+        elif merged[k]:
+            i, j = np.argwhere(overlap[k])[0]
+            if exact_zero is not None and exact_zero[k] and only_zero[k]:
+                label[k], reason[k] = "marginal", "an exact zero root (a free coordinate)"
+            elif at_zero[k, i] and at_zero[k, j]:
+                label[k] = "boundary"
+                reason[k] = (f"a zero root: roots {lam[k, i]:.3g} and {lam[k, j]:.3g} lie within their error "
+                             f"bounds ({r[k, i]:.2g}) of zero and of each other")
+            else:
+                label[k] = "boundary"
+                reason[k] = (f"roots {lam[k, i]:.6g} and {lam[k, j]:.6g} merge within their error bounds "
+                             f"({r[k, i]:.2g}, {r[k, j]:.2g}): a possible collision")
+        elif not conservative and on_axis[k]:
+            label[k], reason[k] = "boundary", "a root's real part lies within its error bound of zero"
+    return Verdict(label, reason)

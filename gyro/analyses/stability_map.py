@@ -21,4 +21,5 @@ def stability_grid(model: Model, values: dict, xname, xrange, yname, yrange, poi
     return StabilityMap(model.name, model.meta["title"], {p.name: p.unit for p in model.params},
                         xs, ys, xname, yname, st.label.reshape(X.shape), st.growth_rate.reshape(X.shape),
                         st.unstable_roots.reshape(X.shape), st.slowest_growth.reshape(X.shape), xlog, ylog,
-                        {k: v for k, v in values.items() if v != model.defaults[k] and k not in (xname, yname)})
+                        {k: v for k, v in values.items() if v != model.defaults[k] and k not in (xname, yname)},
+                        st.reason.reshape(X.shape))

@@ -1,11 +1,15 @@
 """`gyro stability-map MODEL --x NAME --x-range LO HI --y NAME --y-range LO HI [--x-log]
-[--y-log] --out FILE.png`"""
+[--y-log] --out FILE.png [--json]`: the figure, and with --json the document of
+gyro.results.StabilityMap.to_dict (keys x, y as `gyro map`, values: the class per point,
+boundary: where rounding could change the verdict) instead of the summary line."""
 from __future__ import annotations
 
+import json
 import math
 import sys
 
-from gyro.cli.common import add_model, add_out, add_points, add_quiet, add_set, check_png_out, model_with_equilibrium, parse_sets
+from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_set, check_png_out,
+                             model_with_equilibrium, parse_sets)
 from gyro.errors import ParameterError
 
 ORDER = 30
@@ -26,6 +30,7 @@ def register(sub) -> None:
     s.add_argument("--x-log", action="store_true", help="log-spaced x axis (needs 0 < LO)")
     s.add_argument("--y-log", action="store_true", help="log-spaced y axis (needs 0 < LO)")
     add_out(s)
+    add_json(s)
     add_quiet(s)
     s.set_defaults(run=run)
 
@@ -51,5 +56,5 @@ def run(args) -> int:
     grid = stability_grid(model, values, args.x, args.x_range, args.y, args.y_range,
                           args.points, progress=not args.quiet and sys.stderr.isatty(), xlog=args.x_log, ylog=args.y_log)
     grid.plot(out)
-    print(grid.summary(out))
+    print(json.dumps(grid.to_dict(), allow_nan=False) if args.json else grid.summary(out))
     return 0

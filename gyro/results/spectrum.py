@@ -7,6 +7,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from gyro.results import verdict
 from gyro.results._io import _load_npz, _pyplot, _save_npz
 
 
@@ -70,7 +71,8 @@ class Spectrum:
                 "unknown": (f" (the method '{self.method}' computes no growth rates: no verdict; try --method "
                             "default)" if not self.growth_known else
                             " (a root's error is unbounded: this method cannot tell; try --method default)"),
-                "failed": " (these parameters could not be computed)"}.get(label, "")
+                "failed": " (these parameters could not be computed)",
+                "boundary": f" (rounding could change the verdict: {stab.reason[k]})"}.get(label, "")
         lines.append(f"equilibrium: {label}{note}")
         return "\n".join(lines)
 
@@ -99,14 +101,17 @@ class Spectrum:
 
 @dataclass
 class Stability:
-    """Per set: 'stable', 'unstable' (with its growth rate, 1/s), 'marginal' (a root whose
-    real part, or whose frequency, is zero only within its error estimate), 'unknown' (a
-    root's error is unbounded) or 'failed' (the set could not be computed)."""
+    """Per set: 'stable', 'unstable' (with its growth rate, 1/s), 'marginal' (an exact zero
+    root: a neutral direction), 'boundary' (rounding could change the verdict: two roots
+    merged within their error bounds, or a root not resolved from zero), 'unknown' (a
+    root's error is unbounded) or 'failed' (the set could not be computed): the labels of
+    gyro.results.verdict."""
 
     label: np.ndarray  # (sets,) str
     growth_rate: np.ndarray  # (sets,) largest real part, 1/s (0 when stable)
     unstable_roots: np.ndarray  # (sets,) int: growing modes (eigenvalue pairs, or quadruples, with a growing member)
     slowest_growth: np.ndarray  # (sets,) smallest growing real part, 1/s (0 when stable)
+    reason: np.ndarray | None = None  # (sets,) why a set is 'boundary' (gyro.results.verdict); None elsewhere
 
 
 def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
@@ -135,12 +140,31 @@ def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
     unknown = ~np.all(bounded, axis=1)
     if not spec.growth_known:  # the formulas assume a stable gyrocompass: no growth rates
         unknown = np.ones(len(lam), bool)
+    # boundaries (gyro.results.verdict): rounding could change the verdict where two resolved
+    # roots lie within their error bounds of each other (a possible Krein collision or
+    # Jordan block), or where a root is not resolved from zero but is not an exact zero
+    # (rounding decides whether it is a zero root, an oscillation or a growth: phi = 90 deg)
+    radius = np.where(resolved & (lam > 0), np.where(resolved, est, 0.0) * lam, -np.inf)  # -inf: meets none
+    merged = np.any(verdict.overlapping(spec.growth + 1j * spec.frequencies, radius), axis=2) & resolved
+    unresolved = bounded & ~resolved & (lam > 0)
+    boundary = (merged | unresolved).any(axis=1)
     label = np.where(failed, "failed", np.where(
         growing.any(axis=1), "unstable", np.where(
-            unknown, "unknown", np.where(neutral.any(axis=1), "marginal", "stable"))))
+            unknown, "unknown", np.where(boundary, "boundary", np.where(neutral.any(axis=1), "marginal", "stable")))))
+    reason = np.full(len(label), None, dtype=object)
+    for k in np.flatnonzero(label == "boundary"):
+        if unresolved[k].any():
+            j = int(np.argmax(unresolved[k]))
+            reason[k] = (f"root {j + 1} ({lam[k, j]:.3g} rad/s) is not resolved from zero (relative error "
+                         f"{est[k, j]:.2g}): rounding decides whether it is a zero root")
+        else:
+            i, j = np.flatnonzero(merged[k])[:2]
+            reason[k] = (f"roots {i + 1} and {j + 1} ({lam[k, i]:.9g}, {lam[k, j]:.9g} rad/s) merge within their "
+                         "error bounds: a possible collision")
     rate = np.where(growing, spec.growth, 0.0).max(axis=1)
     slowest = np.where(growing, spec.growth, np.inf).min(axis=1)
-    return Stability(label.astype(object), rate, growing.sum(axis=1), np.where(np.isfinite(slowest), slowest, 0.0))
+    return Stability(label.astype(object), rate, growing.sum(axis=1), np.where(np.isfinite(slowest), slowest, 0.0),
+                     reason)
 
 
 @dataclass

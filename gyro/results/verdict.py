@@ -84,6 +84,13 @@ def condition(margin: np.ndarray, bound: np.ndarray, names) -> tuple[np.ndarray,
     return holds, decided, reason
 
 
+def overlapping(lam: np.ndarray, radius: np.ndarray) -> np.ndarray:
+    """(sets, m, m): the disks |z - lam_i| <= radius_i and |z - lam_j| <= radius_j meet
+    (i != j): the exact roots there may coincide."""
+    d = np.abs(lam[:, :, None] - lam[:, None, :])
+    return (d <= radius[:, :, None] + radius[:, None, :]) & ~np.eye(lam.shape[1], dtype=bool)
+
+
 def spectrum(lam: np.ndarray, radius: np.ndarray, conservative: bool = True,
              exact_zero: np.ndarray | None = None) -> Verdict:
     """Verdicts from eigenvalues lam (sets, m) and error radii (sets, m): the exact roots
@@ -106,8 +113,7 @@ def spectrum(lam: np.ndarray, radius: np.ndarray, conservative: bool = True,
     unbounded = ~np.all(np.isfinite(radius), axis=1) & ~failed
     r = np.where(np.isfinite(radius), radius, np.inf)
     grows = np.any(lam.real > r, axis=1) & ~failed
-    d = np.abs(lam[:, :, None] - lam[:, None, :])
-    overlap = (d <= r[:, :, None] + r[:, None, :]) & ~np.eye(m, dtype=bool)
+    overlap = overlapping(lam, r)
     at_zero = np.abs(lam) <= r
     merged = np.any(overlap, axis=(1, 2))
     only_zero = np.all(~overlap | (at_zero[:, :, None] & at_zero[:, None, :]), axis=(1, 2))

@@ -32,9 +32,10 @@ class FrequencySweep:
 
     def summary(self, out) -> str:
         c = classify(self.spectrum).label
+        rest = "".join(f", {int(np.sum(c == k))} {k}" for k in ("boundary", "unknown", "failed") if np.any(c == k))
         return (f"gyro: wrote {out} ({len(self.x)} values of {self.xname}: "
                 f"{int(np.sum(c == 'stable'))} stable, {int(np.sum(c == 'marginal'))} marginal, "
-                f"{int(np.sum(c == 'unstable'))} unstable)")
+                f"{int(np.sum(c == 'unstable'))} unstable{rest})")
 
     def plot(self, out) -> None:
         plt = _pyplot()

@@ -2,8 +2,10 @@
 NAME=VALUE]... [--orbit] [--json]`: over a grid of two axes (parameters, or theta = (C - A)/I
 and chi = (C - B)/I, which move A and B), 2 where (3.6) holds ((4.3) with --orbit), 1 where
 the linearisation is spectrally stable outside it (gyroscopic stabilisation), 0 where it is
-unstable. lambda follows 1 + chi at every point unless set. Every grid point must have a
-relative equilibrium: otherwise exit 2, naming the point.
+unstable, -1 where rounding could change the verdict (a boundary; --json: `boundary`, N_y
+rows of N_x booleans), -2 where a zero root is exact (marginal). lambda follows 1 + chi at
+every point unless set. Every grid point must have a relative equilibrium: otherwise exit
+2, naming the point.
 """
 from __future__ import annotations
 

@@ -1,7 +1,8 @@
 """`gyro stability gyrohorizoncompass [--set NAME=VALUE]... [--orbit] [--json]`: the relative
 equilibrium (3.1)-(3.2), the margins of the sufficient conditions (3.6) (or (4.3) on a
 circular orbit, --orbit: zeta = nu, eta = 0) and of C1's Sylvester minors, and the spectrum
-of the linearisation (companion eigensolve of the emitted operator).
+of the linearisation (companion eigensolve of the emitted operator), with the verdict:
+`boundary` (and `boundary_reason`, one line) where rounding could change it.
 
 Parameters: A B C J L I nu zeta eta lambda (SI; lambda defaults to 1 + chi). Bad input, or a
 set without a relative equilibrium, exits with 2 and one line naming the parameter or the

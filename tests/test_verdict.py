@@ -175,6 +175,21 @@ def test_a_set_on_the_boundary_is_a_boundary_not_stable(name):
     assert s.to_dict()["boundary"] is True and len(s.to_dict()["boundary_reason"].splitlines()) == 1
 
 
+def test_zeta_0_is_marginal_not_stable():
+    """At zeta = 0 exactly (no compass effect) the printed rows of (3.6) all hold, but C1's
+    first minor I (1 + theta) zeta^2 is 0: V is only semidefinite, and the stiffness leaves
+    alpha free (an exact double zero root). The verdict is marginal, not stable: the rows
+    of (3.6) are C1 > 0 only given zeta != 0 (and epsilon0 != 0), so C1's minors are
+    required with them."""
+    v = ghc.parameters({"A": 1, "B": 1.05, "C": 1.1, "J": 1, "L": 0.5, "I": 1, "nu": 1, "zeta": 0, "eta": 0.2})
+    s = ghc.stability(v)
+    assert all(s.conditions[k] > 0 for k in s.conditions if k.startswith("(3.6)"))
+    assert s.verdict == "marginal" and not s.sufficient and not s.spectrally_stable and not s.boundary
+    assert "exact zero root" in s.table().splitlines()[-1]
+    s = ghc.stability(dict(v, zeta=1e-3))  # a small compass effect: decided, and stable
+    assert s.verdict == "stable" and s.sufficient
+
+
 def test_the_verdict_module():
     """condition: holds, fails, undecided; spectrum: a simple axis root is stable (the
     conservative argument), a disk right of the axis unstable, two disks that meet a
@@ -186,7 +201,7 @@ def test_the_verdict_module():
     lam = np.array([[1e-17 + 1j, 1e-17 - 1j], [0.1 + 1j, 0.1 - 1j], [1e-9 + 1j, -1e-9 + 1j],
                     [1e-20, -1e-20], [1e-20, -1e-20], [np.nan, 1j], [1j, -1j]])
     rad = np.array([[1e-15] * 2, [1e-15] * 2, [1e-8] * 2, [1e-15] * 2, [1e-15] * 2, [1e-15] * 2, [np.inf] * 2])
-    v = verdict.spectrum(lam, rad, exact_zero=np.array([0, 0, 0, 0, 1, 0, 0], bool))
+    v = verdict.spectrum(lam, rad, exact_zero=np.array([0, 0, 0, 0, 1, 0, 0]))
     assert v.label.tolist() == ["stable", "unstable", "boundary", "boundary", "marginal", "failed", "unknown"]
     assert "collision" in v.reason[2] and "zero root" in v.reason[3]
     assert verdict.spectrum(lam[:1], rad[:1], conservative=False).label[0] == "boundary"

@@ -170,13 +170,25 @@ def analyse(P: np.ndarray, orbit: np.ndarray | bool = False) -> dict:
     # the sufficient condition in force at each set, its margins and their rounding bounds
     which = np.where(orbit, 2, np.where(exact, 1, 0))
     held, decided, why = (np.empty(n, bool), np.empty(n, bool), np.empty(n, object))
-    for code, marg, bnd, names in ((0, syl, bounds[0], SYLVESTER), (1, c36, bounds[1], C36),
-                                   (2, c43, bounds[2], C43)):
+    rounded = np.zeros(n, bool)
+    # the printed rows are C1 > 0 only given zeta != 0 and epsilon0 != 0 (the paper's own
+    # proviso): C1's minors are required with them, so that zeta = 0 exactly (m1 = 0: no
+    # compass effect, V only semidefinite) is no 'stable'
+    both = lambda a, b: np.concatenate([a, b], axis=1)  # noqa: E731
+    for code, marg, bnd, names in ((0, syl, bounds[0], SYLVESTER),
+                                   (1, both(c36, syl), both(bounds[1], bounds[0]), C36 + SYLVESTER),
+                                   (2, both(c43, syl), both(bounds[2], bounds[0]), C43 + SYLVESTER)):
         rows = which == code
         if rows.any():
             held[rows], decided[rows], why[rows] = verdict.condition(marg[rows], bnd[rows], names)
+            # a margin near zero whose terms do not all vanish: its zero is rounding's
+            rounded[rows] = np.any((np.abs(marg[rows]) <= bnd[rows]) & (bnd[rows] > 0), axis=1)
     sufficient = held & ok
-    spec = verdict.spectrum(eig, radius, conservative=True, exact_zero=free_coordinate(K))
+    # a free coordinate is exact only where no margin is zero merely within rounding (at
+    # zeta = 0 every term of m1 vanishes; at lambda + theta - chi = 0 on the orbit c11 may
+    # round to 0 exactly, yet nearby inputs give either sign)
+    free = np.where(rounded, 0, free_coordinate(K))
+    spec = verdict.spectrum(eig, radius, conservative=True, exact_zero=free)
     growth = np.max(eig.real, axis=1)
     stable = ok & ((spec.label == "stable") | sufficient)  # C1 > 0 puts the spectrum on the axis
     # the verdict of the set: (3.6)/(4.3) decided and holding is stable whatever the spectrum;
@@ -186,7 +198,8 @@ def analyse(P: np.ndarray, orbit: np.ndarray | bool = False) -> dict:
     label, reason = spec.label.copy(), spec.reason.copy()
     label[sufficient] = "stable"
     reason[sufficient] = None
-    undecided = ok & ~decided & (spec.label != "unstable")
+    # (an exact zero root, marginal, explains an undecided margin: it stays marginal)
+    undecided = ok & ~decided & (spec.label != "unstable") & (spec.label != "marginal")
     label[undecided], reason[undecided] = "boundary", why[undecided]
     label[~ok], reason[~ok] = "failed", "no relative equilibrium, or an operator that is not finite"
     return {"epsilon0": eps0[:, 0], "exists": margins[:, 0], "theta": tc[:, 0], "chi": tc[:, 1],
@@ -228,10 +241,12 @@ def eigen_radii(A: np.ndarray, M: np.ndarray):
 
 
 def free_coordinate(K: np.ndarray) -> np.ndarray:
-    """Per set: the stiffness has an exactly zero row and column (a coordinate that no
-    restoring moment holds, as alpha at zeta = 0): its zero root is exact, not rounding's."""
+    """Per set: how many coordinates the stiffness leaves free (an exactly zero row and
+    column: no restoring moment, as alpha at zeta = 0); each has an exact double zero root,
+    unless the zero entries are a rounding coincidence, which `analyse` rules out by the
+    margins' bounds."""
     z = np.all(K == 0, axis=2) & np.all(K == 0, axis=1)
-    return np.any(z, axis=1)
+    return np.sum(z, axis=1)
 
 
 def stability(values: dict, orbit: bool = False):

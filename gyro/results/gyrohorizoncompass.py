@@ -69,7 +69,7 @@ class EquilibriumStability:
             lines.append(f"boundary: rounding could change the verdict ({self.boundary_reason})")
             return "\n".join(lines)
         if self.verdict == "marginal":
-            lines.append(f"marginal: {self.boundary_reason}; the linearisation decides nothing")
+            lines.append(f"marginal: {self.boundary_reason}")
             return "\n".join(lines)
         verdict = ("stable: the sufficient condition holds" if self.sufficient else
                    "spectrally stable outside the sufficient condition (gyroscopic stabilisation)"

@@ -105,10 +105,25 @@ def spectrum(lam: np.ndarray, radius: np.ndarray, conservative: bool = True,
       same disk, is the root itself: it is on the axis); without `conservative` every
       disk must lie in Re z < 0, a disk that meets the axis being a boundary.
 
-    `exact_zero` (sets,): sets where a zero root is known exactly (a free coordinate);
-    their only overlapping disks being those at zero, they are marginal."""
+    `exact_zero` (sets,) int: the number of free coordinates, each with an exact double
+    zero root (known from the structure, not from rounding). Their 2 per coordinate roots
+    of least modulus are set aside (their disks say nothing: a Jordan block's radius is
+    huge), and the rest decides: a set that would be stable is marginal."""
     lam, radius = np.atleast_2d(lam), np.atleast_2d(radius)
     n, m = lam.shape
+    if exact_zero is not None and np.any(exact_zero):
+        zeros = 2 * np.asarray(exact_zero, int)
+        order = np.argsort(np.where(np.isfinite(lam), np.abs(lam), np.inf), axis=1)
+        aside = np.zeros(lam.shape, bool)
+        for k in np.flatnonzero(zeros):
+            aside[k, order[k, :zeros[k]]] = True
+        # set aside: moved far apart from each other and the rest, with no radius
+        far = np.where(aside, 1e300 * (1 + np.arange(m))[None, :] * 1j, lam)
+        v = spectrum(far, np.where(aside, 0.0, radius), conservative)
+        marg = np.asarray(zeros > 0) & (v.label == "stable")
+        v.label[marg] = "marginal"
+        v.reason[marg] = "an exact zero root (a free coordinate): the linearisation decides nothing"
+        return v
     failed = ~np.all(np.isfinite(lam), axis=1)
     unbounded = ~np.all(np.isfinite(radius), axis=1) & ~failed
     r = np.where(np.isfinite(radius), radius, np.inf)
@@ -116,7 +131,6 @@ def spectrum(lam: np.ndarray, radius: np.ndarray, conservative: bool = True,
     overlap = overlapping(lam, r)
     at_zero = np.abs(lam) <= r
     merged = np.any(overlap, axis=(1, 2))
-    only_zero = np.all(~overlap | (at_zero[:, :, None] & at_zero[:, None, :]), axis=(1, 2))
     on_axis = np.any(np.abs(lam.real) <= r, axis=1)
     label = np.full(n, "stable", dtype=object)
     reason = np.full(n, None, dtype=object)
@@ -130,9 +144,7 @@ def spectrum(lam: np.ndarray, radius: np.ndarray, conservative: bool = True,
             label[k], reason[k] = "unknown", "a root's error is unbounded"
         elif merged[k]:
             i, j = np.argwhere(overlap[k])[0]
-            if exact_zero is not None and exact_zero[k] and only_zero[k]:
-                label[k], reason[k] = "marginal", "an exact zero root (a free coordinate)"
-            elif at_zero[k, i] and at_zero[k, j]:
+            if at_zero[k, i] and at_zero[k, j]:
                 label[k] = "boundary"
                 reason[k] = (f"a zero root: roots {lam[k, i]:.3g} and {lam[k, j]:.3g} lie within their error "
                              f"bounds ({r[k, i]:.2g}) of zero and of each other")

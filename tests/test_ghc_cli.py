@@ -149,8 +149,12 @@ def test_stability_json_has_the_contract_keys():
     assert rc == 0, err
     d = json.loads(out)
     assert set(d) == {"model", "params", "equilibrium", "theta", "chi", "conditions", "sufficient",
-                      "eigenvalues", "spectrally_stable", "boundary", "boundary_reason", "verdict"}
+                      "eigenvalues", "spectrally_stable", "boundary", "boundary_reason", "verdict", "margin_bounds"}
     assert d["boundary"] is False and d["boundary_reason"] is None and d["verdict"] == "stable"
+    assert set(d["margin_bounds"]) == set(d["conditions"])
+    # the bounds are k u sum|terms| (k <= 286 for the last minor, the terms O(1) here): below
+    # 2e-12, against margins of 0.06 and more: decided by ten orders of magnitude
+    assert all(0 < d["margin_bounds"][k] < 1e-10 * d["conditions"][k] for k in d["conditions"])
     assert d["model"] == "gyrohorizoncompass"
     assert set(d["params"]) == {"A", "B", "C", "J", "L", "I", "nu", "zeta", "eta", "lambda"}
     assert math.isclose(d["params"]["lambda"], 1.05, rel_tol=1e-14)  # 1 + chi by default

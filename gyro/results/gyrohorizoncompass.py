@@ -45,7 +45,8 @@ class EquilibriumStability:
                 "eigenvalues": [[float(a), float(b)] for a, b in np.asarray(self.eigenvalues)],
                 "spectrally_stable": bool(self.spectrally_stable),
                 "boundary": self.boundary, "boundary_reason": self.boundary_reason if self.boundary else None,
-                "verdict": self.verdict}
+                "verdict": self.verdict,
+                "margin_bounds": {k: float(v) for k, v in self.margin_bounds.items()}}
 
     @property
     def gyroscopically_stabilised(self) -> bool:

@@ -47,7 +47,8 @@ class Spectrum:
             "method": self.method,
             "error_estimate": [float(e) if np.isfinite(e) else None for e in self.error_estimate[k]],
             "stability": {"class": str(stab.label[k]), "growth_rate": float(stab.growth_rate[k]),
-                          "unstable_roots": int(stab.unstable_roots[k])},
+                          "unstable_roots": int(stab.unstable_roots[k]),
+                          "reason": None if stab.reason is None else stab.reason[k]},
         }
 
     def table(self, k: int, model) -> str:

@@ -10,6 +10,8 @@ One module per kind of result; every name is importable from `gyro.results`.
 - `sweep`: `FrequencySweep` (frequencies against any one parameter);
 - `trajectory`: `Trajectory` (the gimbal's motion: closed form or an integrator);
 - `gyrohorizoncompass`: `EquilibriumStability`, `ConditionMap`, `AngleTrajectory`;
+- `sensitivity`: `Sensitivities` (d omega / d p of every frequency and parameter);
+- `tolerance`: `ToleranceStudy` (frequency distributions over manufacturing spreads);
 - `_io`: atomic saving of arrays and figures, shared by all.
 """
 from __future__ import annotations
@@ -18,10 +20,11 @@ from gyro.results._io import TMP_TAG, save_figure
 from gyro.results.campbell import FORMULA_BAD, CampbellDiagram
 from gyro.results.gyrohorizoncompass import AngleTrajectory, ConditionMap, EquilibriumStability
 from gyro.results.spectrum import ModalResult, Spectrum, Stability, classify, nearest_error
+from gyro.results.sensitivity import Sensitivities
 from gyro.results.stability_map import StabilityMap
 from gyro.results.sweep import FrequencySweep
 from gyro.results.trajectory import Trajectory
 
 __all__ = ["TMP_TAG", "save_figure", "FORMULA_BAD", "CampbellDiagram", "AngleTrajectory", "ConditionMap",
            "EquilibriumStability", "ModalResult", "Spectrum", "Stability", "classify", "nearest_error",
-           "StabilityMap", "FrequencySweep", "Trajectory"]
+           "StabilityMap", "FrequencySweep", "Trajectory", "Sensitivities"]

@@ -83,32 +83,36 @@ def partials(model: Model, P: np.ndarray, qe: np.ndarray, route: str = "auto"):
     return out
 
 
-def _null_vectors(J: np.ndarray):
-    """Right and left null vectors of a batch of (nearly) singular J: two steps of inverse
-    iteration from a fixed generic start (a root accurate to 1e-14 leaves the vector's
-    other components at that size after one step). Where J is singular to the last bit, on
-    J + 1e-13 |J| I (which moves the null vector by 1e-13 |J| over the next singular
-    value: nothing at the accuracy of a sensitivity), and the SVD as the last resort."""
-    n = J.shape[-1]
-    b = np.broadcast_to(np.exp(1j * np.arange(1, n + 1)) / np.sqrt(n), J.shape[:-1]).copy()
-    scale = np.max(np.abs(J), axis=(-2, -1), keepdims=True)
-    out = []
-    for A in (J, np.conj(np.swapaxes(J, -1, -2))):
-        v = None
-        for shift in (0.0, 1e-13):
-            try:
-                v = b
-                As = A + shift * scale * np.eye(n) if shift else A
-                for _ in range(2):
-                    v = np.linalg.solve(As, v[..., None])[..., 0]
-                    v /= np.linalg.norm(v, axis=-1, keepdims=True)
-                break
-            except np.linalg.LinAlgError:
-                v = None
-        if v is None:
-            v = np.conj(np.linalg.svd(A)[2][..., -1, :])
-        out.append(v)
-    return out
+def _solve_or_svd(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """One step of inverse iteration on a flat batch (k, n, n) from b (k, n); a matrix
+    singular to the last bit (LAPACK refuses the whole batch) is found by halving the
+    batch, and takes its null vector from the SVD."""
+    try:
+        v = np.linalg.solve(A, b[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        if A.shape[0] == 1:
+            return np.conj(np.linalg.svd(A)[2][:, -1, :])
+        h = A.shape[0] // 2
+        return np.concatenate([_solve_or_svd(A[:h], b[:h]), _solve_or_svd(A[h:], b[h:])])
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def _null_vectors(J: np.ndarray, hermitian: np.ndarray):
+    """Right and left null vectors of a batch (sets, modes, n, n) of (nearly) singular J:
+    one step of inverse iteration from a fixed generic start (a root accurate to 1e-14
+    leaves the vector's other components at that size); the left one is the right one
+    where J is Hermitian (a conservative set at a root on the imaginary axis, `hermitian`
+    per set). No shift: the entries of J span eleven decades here, and any shift of the
+    largest one's size would move the small roots' vectors."""
+    N, m, n = J.shape[:3]
+    b = np.broadcast_to(np.exp(1j * np.arange(1, n + 1)) / np.sqrt(n), (N * m, n))
+    x = _solve_or_svd(J.reshape(N * m, n, n), b).reshape(N, m, n)
+    y = x.copy()
+    h = np.flatnonzero(~hermitian)
+    if h.size:
+        Jh = np.conj(np.swapaxes(J[h], -1, -2)).reshape(h.size * m, n, n)
+        y[h] = _solve_or_svd(Jh, b[:h.size * m]).reshape(h.size, m, n)
+    return x, y
 
 
 def double_roots(spec: Spectrum) -> np.ndarray:
@@ -141,22 +145,27 @@ def _chunk(model: Model, P: np.ndarray, spec: Spectrum, route: str) -> np.ndarra
     M, D, K = operators(model, P, qe)
     # dq_e/dp from r(p, q_e) = 0, on the rows of the equilibrium equations
     drq, drp = dr[:, idx, npar:], dr[:, idx, :npar]
+    # only the entries of M, D, K that some set has nonzero enter the contraction
+    live = np.flatnonzero(np.any(dJ != 0, axis=(0, 2)))
+    dJ = dJ[:, live]
     with np.errstate(all="ignore"):
         dq = -np.linalg.solve(drq, drp) if nq else np.zeros((k.size, 0, npar))
-        total = dJ[:, :, :npar] + dJ[:, :, npar:] @ dq  # (sets, 3 n^2, params)
-    # only the entries some set has nonzero enter the contraction
-    live = np.flatnonzero(np.any(total != 0, axis=(0, 2)))
+        total = dJ[:, :, :npar] + dJ[:, :, npar:] @ dq  # (sets, live entries, params)
     which, entry = np.divmod(live, n * n)
     row, col = np.divmod(entry, n)
     lam = spec.growth[k] + 1j * spec.frequencies[k]  # (sets, modes)
     L = lam[:, :, None, None]
     J = M[:, None] * L**2 + D[:, None] * L + K[:, None]
-    x, y = _null_vectors(J)
-    dlam = 2 * M[:, None] * L + D[:, None]
-    den = np.einsum("bmi,bmij,bmj->bm", np.conj(y), dlam, x)
+    # J(i omega) is Hermitian for M, K symmetric and D skew (to the last bit) at growth 0
+    T = lambda X: np.swapaxes(X, -1, -2)  # noqa: E731
+    hermitian = (np.all(M == T(M), axis=(1, 2)) & np.all(K == T(K), axis=(1, 2)) & np.all(D == -T(D), axis=(1, 2))
+                 & np.all(spec.growth[k] == 0, axis=1))
+    x, y = _null_vectors(J, hermitian)
+    yc = np.conj(y)
+    den = 2 * lam * np.sum(yc * (x @ T(M)), axis=-1) + np.sum(yc * (x @ T(D)), axis=-1)  # y* J'(lambda) x
     weight = np.stack([lam**2, lam, np.ones_like(lam)], axis=-1)  # dM lambda^2 + dD lambda + dK
-    G = np.conj(y)[:, :, row] * x[:, :, col] * weight[:, :, which]  # (sets, modes, live)
-    num = G @ total[:, live, :]  # (sets, modes, params)
+    G = yc[:, :, row] * x[:, :, col] * weight[:, :, which]  # (sets, modes, live)
+    num = G @ total  # (sets, modes, params)
     with np.errstate(all="ignore"):
         d = -num / den[:, :, None]
     out[k] = np.sign(lam.imag)[:, :, None] * d.imag

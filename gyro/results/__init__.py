@@ -23,8 +23,9 @@ from gyro.results.spectrum import ModalResult, Spectrum, Stability, classify, ne
 from gyro.results.sensitivity import Sensitivities
 from gyro.results.stability_map import StabilityMap
 from gyro.results.sweep import FrequencySweep
+from gyro.results.tolerance import ToleranceStudy
 from gyro.results.trajectory import Trajectory
 
 __all__ = ["TMP_TAG", "save_figure", "FORMULA_BAD", "CampbellDiagram", "AngleTrajectory", "ConditionMap",
            "EquilibriumStability", "ModalResult", "Spectrum", "Stability", "classify", "nearest_error",
-           "StabilityMap", "FrequencySweep", "Trajectory", "Sensitivities"]
+           "StabilityMap", "FrequencySweep", "Trajectory", "Sensitivities", "ToleranceStudy"]

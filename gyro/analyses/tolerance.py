@@ -103,13 +103,12 @@ def spin_rate(model: Model, P: np.ndarray) -> np.ndarray | None:
     return P[:, model.param_names.index("H")] / P[:, model.param_names.index("C")]
 
 
-def samples(nominal, index, relwidth, uniform, chol, seed, start, stop):
-    """The parameter sets start..stop of the study (start a multiple of CHUNK)."""
+def samples(nominal, index, relwidth, uniform, chol, seed, start, stop, chunk=CHUNK):
+    """The parameter sets start..stop of the study (start a multiple of `chunk`)."""
     from scipy.special import ndtr
 
-    c = start // CHUNK
-    rng = np.random.default_rng([seed, c])
-    z = rng.standard_normal((CHUNK, len(index)))[: stop - start] @ chol.T
+    rng = np.random.default_rng([seed, start // chunk])
+    z = rng.standard_normal((chunk, len(index)))[: stop - start] @ chol.T
     dev = np.where(uniform, 2 * ndtr(z) - 1, z) * relwidth
     P = np.tile(nominal, (stop - start, 1))
     P[:, index] *= 1 + dev
@@ -133,10 +132,10 @@ def valid(model: Model, P: np.ndarray) -> np.ndarray:
     return ok
 
 
-def chunk(start, stop, model_ref, nominal, index, relwidth, uniform, chol, seed):
+def chunk(start, stop, model_ref, nominal, index, relwidth, uniform, chol, seed, size=CHUNK):
     """One chunk of the study: the samples' frequencies (NaN where failed) and spin rates."""
     model = load(model_ref)
-    P = samples(nominal, index, relwidth, uniform, chol, seed, start, stop)
+    P = samples(nominal, index, relwidth, uniform, chol, seed, start, stop, size)
     ok = valid(model, P)
     n = len(model.meta["reduced"])
     freq = np.full((stop - start, n), np.nan)
@@ -152,7 +151,9 @@ def chunk(start, stop, model_ref, nominal, index, relwidth, uniform, chol, seed)
 
 def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: int = 0,
               pairs: dict | None = None, scheduler=None, harmonics=(), band: float = 0.02,
-              store: Path | None = None, progress: bool = False) -> ToleranceStudy:
+              store: Path | None = None, progress: bool = False, size: int = CHUNK) -> ToleranceStudy:
+    """The study over n samples; `size` samples a chunk (with the seed, it fixes the
+    samples: chunk c draws from the generator seeded with (seed, c))."""
     from gyro.analyses.sensitivity import sensitivities
 
     names = [s.name for s in spreads]
@@ -186,7 +187,7 @@ def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: i
         folder = Path(tmp.name)
     try:
         ref = model_ref(model)
-        out = executor.run(chunk, n, CHUNK, (ref, nominal, index, relwidth, uniform, chol, seed), scheduler,
+        out = executor.run(chunk, n, size, (ref, nominal, index, relwidth, uniform, chol, seed, size), scheduler,
                            folder, progress, "tolerance", warm=warm, warm_args=(ref,))
         F = out["frequencies"]
         ok = np.all(np.isfinite(F), axis=1)

@@ -83,36 +83,54 @@ def partials(model: Model, P: np.ndarray, qe: np.ndarray, route: str = "auto"):
     return out
 
 
-def _solve_or_svd(A: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """One step of inverse iteration on a flat batch (k, n, n) from b (k, n); a matrix
-    singular to the last bit (LAPACK refuses the whole batch) is found by halving the
-    batch, and takes its null vector from the SVD."""
+def _solve_or_svd(A: np.ndarray, b: np.ndarray, halve: bool = True) -> np.ndarray:
+    """One step of inverse iteration on a flat batch (k, n, n) from b (k, n); with `halve`,
+    a matrix singular to the last bit (LAPACK refuses the whole batch) is found by halving
+    the batch, and takes its null vector from the SVD; without, LinAlgError."""
     try:
         v = np.linalg.solve(A, b[..., None])[..., 0]
     except np.linalg.LinAlgError:
+        if not halve:
+            raise
         if A.shape[0] == 1:
             return np.conj(np.linalg.svd(A)[2][:, -1, :])
         h = A.shape[0] // 2
-        return np.concatenate([_solve_or_svd(A[:h], b[:h]), _solve_or_svd(A[h:], b[h:])])
+        return np.concatenate([_solve_or_svd(A[:h], b[:h], halve), _solve_or_svd(A[h:], b[h:], halve)])
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
-def _null_vectors(J: np.ndarray, hermitian: np.ndarray):
-    """Right and left null vectors of a batch (sets, modes, n, n) of (nearly) singular J:
-    one step of inverse iteration from a fixed generic start (a root accurate to 1e-14
-    leaves the vector's other components at that size); the left one is the right one
-    where J is Hermitian (a conservative set at a root on the imaginary axis, `hermitian`
-    per set). No shift: the entries of J span eleven decades here, and any shift of the
-    largest one's size would move the small roots' vectors."""
-    N, m, n = J.shape[:3]
+def _null_vectors(M, D, K, lam, hermitian):
+    """Right and left null vectors of J(lambda) for a batch (sets, modes): one step of
+    inverse iteration from a fixed generic start (a root accurate to 1e-14 leaves the
+    vector's other components at that size); the left one is the right one where J is
+    Hermitian (a conservative set at a root on the imaginary axis, `hermitian` per set).
+    Where J(lambda) is singular to the last bit (a decoupled mode, omega_p^2 m = Kp
+    exactly), the step is taken at lambda (1 + 1e-14): a move relative to the root's own
+    scale, which leaves the vector's error at 1e-14 over the relative gap to the next root
+    (at least DOUBLE); a shift of J by a fraction of its largest entry would not (the
+    entries span eleven decades here)."""
+    N, m, n = M.shape[0], lam.shape[1], M.shape[-1]
     b = np.broadcast_to(np.exp(1j * np.arange(1, n + 1)) / np.sqrt(n), (N * m, n))
-    x = _solve_or_svd(J.reshape(N * m, n, n), b).reshape(N, m, n)
-    y = x.copy()
-    h = np.flatnonzero(~hermitian)
-    if h.size:
-        Jh = np.conj(np.swapaxes(J[h], -1, -2)).reshape(h.size * m, n, n)
-        y[h] = _solve_or_svd(Jh, b[:h.size * m]).reshape(h.size, m, n)
-    return x, y
+
+    def J(rel):
+        L = (lam * (1 + rel))[:, :, None, None]
+        return M[:, None] * L**2 + D[:, None] * L + K[:, None]
+
+    def left(A):
+        return np.conj(np.swapaxes(A, -1, -2))
+
+    for rel in (0.0, 1e-14):
+        A = J(rel)
+        try:
+            x = _solve_or_svd(A.reshape(N * m, n, n), b, halve=rel > 0).reshape(N, m, n)
+            y = x.copy()
+            h = np.flatnonzero(~hermitian)
+            if h.size:
+                y[h] = _solve_or_svd(left(A[h]).reshape(h.size * m, n, n), b[:h.size * m], halve=rel > 0
+                                     ).reshape(h.size, m, n)
+            return x, y
+        except np.linalg.LinAlgError:
+            continue
 
 
 def double_roots(spec: Spectrum) -> np.ndarray:
@@ -154,18 +172,16 @@ def _chunk(model: Model, P: np.ndarray, spec: Spectrum, route: str) -> np.ndarra
     which, entry = np.divmod(live, n * n)
     row, col = np.divmod(entry, n)
     lam = spec.growth[k] + 1j * spec.frequencies[k]  # (sets, modes)
-    L = lam[:, :, None, None]
-    J = M[:, None] * L**2 + D[:, None] * L + K[:, None]
     # J(i omega) is Hermitian for M, K symmetric and D skew (to the last bit) at growth 0
     T = lambda X: np.swapaxes(X, -1, -2)  # noqa: E731
     hermitian = (np.all(M == T(M), axis=(1, 2)) & np.all(K == T(K), axis=(1, 2)) & np.all(D == -T(D), axis=(1, 2))
                  & np.all(spec.growth[k] == 0, axis=1))
-    x, y = _null_vectors(J, hermitian)
+    x, y = _null_vectors(M, D, K, lam, hermitian)
     yc = np.conj(y)
     den = 2 * lam * np.sum(yc * (x @ T(M)), axis=-1) + np.sum(yc * (x @ T(D)), axis=-1)  # y* J'(lambda) x
     weight = np.stack([lam**2, lam, np.ones_like(lam)], axis=-1)  # dM lambda^2 + dD lambda + dK
     G = yc[:, :, row] * x[:, :, col] * weight[:, :, which]  # (sets, modes, live)
-    num = G @ total  # (sets, modes, params)
+    num = G.real @ total + 1j * (G.imag @ total)  # (sets, modes, params): two real products
     with np.errstate(all="ignore"):
         d = -num / den[:, :, None]
     out[k] = np.sign(lam.imag)[:, :, None] * d.imag

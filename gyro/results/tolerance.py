@@ -99,11 +99,17 @@ class ToleranceStudy:
                          f"{self.first_order_std[i]:>13.4g} {self.quantiles[i, 0]:>12.6g} {self.quantiles[i, 2]:>12.6g}"
                          f"  {verdict}")
         if self.band_probability is not None:
-            lines.append(f"probability within +-{100 * self.band:g} % of a harmonic k omega_c (sampled / first order):")
+            ks = ", ".join(str(k) for k in self.harmonics)
+            lines.append(f"probability within +-{100 * self.band:g} % of a harmonic k omega_c, k = {ks} "
+                         "(sampled / first order):")
+            shown = 0
             for i, row in enumerate(self.band_probability, 1):
                 cells = [f"k={b['harmonic']}: {b['probability']:.3g} / {b['first_order_probability']:.3g}" for b in row]
                 if any(b["probability"] > 0 or b["first_order_probability"] > 1e-6 for b in row):
                     lines.append(f"{i:>4}   " + "   ".join(cells))
+                    shown += 1
+            if not shown:
+                lines.append("     none: every frequency stays clear (sampled 0, first order below 1e-6)")
         return "\n".join(lines)
 
     def plot(self, out, modes=None) -> None:

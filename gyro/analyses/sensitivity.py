@@ -101,14 +101,14 @@ def _solve_or_svd(A: np.ndarray, b: np.ndarray, halve: bool = True) -> np.ndarra
 
 def _null_vectors(M, D, K, lam, hermitian):
     """Right and left null vectors of J(lambda) for a batch (sets, modes): one step of
-    inverse iteration from a fixed generic start (a root accurate to 1e-14 leaves the
-    vector's other components at that size); the left one is the right one where J is
-    Hermitian (a conservative set at a root on the imaginary axis, `hermitian` per set).
-    Where J(lambda) is singular to the last bit (a decoupled mode, omega_p^2 m = Kp
-    exactly), the step is taken at lambda (1 + 1e-14): a move relative to the root's own
-    scale, which leaves the vector's error at 1e-14 over the relative gap to the next root
-    (at least DOUBLE); a shift of J by a fraction of its largest entry would not (the
-    entries span eleven decades here)."""
+    inverse iteration from a fixed generic start, taken at lambda (1 + 1e-15); the left
+    one is the right one where J is Hermitian (a conservative set at a root on the
+    imaginary axis, `hermitian` per set). The root is accurate to 1e-14, so the step leaves
+    the vector's other components at 1e-14 over the relative gap to the next root (at least
+    DOUBLE); the move keeps J(lambda) from being singular to the last bit (a decoupled mode,
+    omega_p^2 m = Kp exactly, has an exact zero pivot at lambda), and it is relative to the
+    root's own scale: a shift of J by a fraction of its largest entry would not be (the
+    entries span eleven decades here, and omega1's derivative lost five digits to one)."""
     N, m, n = M.shape[0], lam.shape[1], M.shape[-1]
     b = np.broadcast_to(np.exp(1j * np.arange(1, n + 1)) / np.sqrt(n), (N * m, n))
 
@@ -119,18 +119,13 @@ def _null_vectors(M, D, K, lam, hermitian):
     def left(A):
         return np.conj(np.swapaxes(A, -1, -2))
 
-    for rel in (0.0, 1e-14):
-        A = J(rel)
-        try:
-            x = _solve_or_svd(A.reshape(N * m, n, n), b, halve=rel > 0).reshape(N, m, n)
-            y = x.copy()
-            h = np.flatnonzero(~hermitian)
-            if h.size:
-                y[h] = _solve_or_svd(left(A[h]).reshape(h.size * m, n, n), b[:h.size * m], halve=rel > 0
-                                     ).reshape(h.size, m, n)
-            return x, y
-        except np.linalg.LinAlgError:
-            continue
+    A = J(1e-15)
+    x = _solve_or_svd(A.reshape(N * m, n, n), b).reshape(N, m, n)
+    y = x.copy()
+    h = np.flatnonzero(~hermitian)
+    if h.size:
+        y[h] = _solve_or_svd(left(A[h]).reshape(h.size * m, n, n), b[:h.size * m]).reshape(h.size, m, n)
+    return x, y
 
 
 def double_roots(spec: Spectrum) -> np.ndarray:

@@ -138,7 +138,7 @@ def main(argv=None) -> int:
     elif (RESULTS / "scale.json").exists():  # the study of an earlier run stays, with its own load
         old = json.loads((RESULTS / "scale.json").read_text())
         if "tolerance" in old:
-            res["tolerance"] = dict(old["tolerance"], machine=old.get("machine"))
+            res["tolerance"] = dict({"machine": old.get("machine")}, **old["tolerance"])
     res["machine"]["load_average_at_end"] = os.getloadavg()
     (RESULTS / "scale.json").write_text(json.dumps(res, indent=1, sort_keys=True) + "\n")
     return 0

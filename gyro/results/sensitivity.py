@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gyro.results._io import _pyplot, _save_npz, save_figure
+from gyro.results._io import _pyplot, _save_npz, mode_panels, save_figure
 from gyro.results.spectrum import Spectrum
 
 
@@ -57,11 +57,7 @@ class Sensitivities:
         plt = _pyplot()
         rel = self.relative[k]
         modes = list(range(rel.shape[0])) if modes is None else list(modes)
-        cols = min(len(modes), 5)
-        rows = -(-len(modes) // cols)
-        fig, axes = plt.subplots(rows, cols, figsize=(3.1 * cols, 2.6 * rows), layout="constrained", squeeze=False)
-        for ax in axes.flat[len(modes):]:
-            ax.axis("off")
+        fig, axes = mode_panels(plt, len(modes), 2.6)
         for ax, i in zip(axes.flat, modes):
             w = self.spectrum.frequencies[k, i]
             ax.set_title(f"omega{i + 1} = {w:.5g} rad/s", fontsize=9)

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gyro.results._io import _pyplot, save_figure
+from gyro.results._io import _pyplot, mode_panels, save_figure
 from gyro.results.sensitivity import Sensitivities
 
 QUANTILE_LEVELS = (0.01, 0.5, 0.99)
@@ -116,11 +116,7 @@ class ToleranceStudy:
         """Histograms of each frequency (relative to nominal) with the first-order normal."""
         plt = _pyplot()
         modes = list(range(len(self.nominal))) if modes is None else list(modes)
-        cols = min(len(modes), 5)
-        rows = -(-len(modes) // cols)
-        fig, axes = plt.subplots(rows, cols, figsize=(3.1 * cols, 2.5 * rows), layout="constrained", squeeze=False)
-        for ax in axes.flat[len(modes):]:
-            ax.axis("off")
+        fig, axes = mode_panels(plt, len(modes), 2.5)
         for ax, i in zip(axes.flat, modes):
             w0 = self.nominal[i]
             e = self.edges[i]

@@ -172,3 +172,37 @@ def test_cli_contract(tg, nominal):
     assert rc == 0 and "relative sensitivities" in out
     rc, out, err = run_cli("frequencies", MODEL, "--sensitivities", "--method", "formulas")
     assert rc == 2 and "--sensitivities" in err and len(err.strip().splitlines()) == 1
+
+
+def test_the_emitted_jacobians_numpy_and_c(tg, nominal):
+    """operator_sensitivity through NumPy and the compiled C, the two the runtime calls (its
+    documented call order: params, qe; tests/test_generated.py takes every emitted function
+    through all four backends against the symbolic result) at the paper's set and a moved
+    one: they agree to rounding (1e-12 of each row's largest entry),
+    and the Jacobian of M, D, K is that of central differences of the emitted operator
+    (step 1e-6 relative: truncation 1e-12, rounding eps / 1e-6 = 2e-10 of the row's scale;
+    bound 1e-8), in relative units p_j dX/dp_j."""
+    from gyro import cbackend
+
+    names = [i["name"] for i in tg.meta["functions"]["operator_sensitivity"]["inputs"]]
+    assert names == ["params", "qe"]
+    npar = len(tg.param_names)
+    for P in (tg.vector(), tg.vector() * 1.03):
+        qe = nominal.spectrum.equilibrium[0]  # any (p, qe) will do: the functions are evaluated, not solved
+        dJ, dr = (np.asarray(a) for a in tg.numpy.operator_sensitivity(P, qe))
+        c = cbackend.batch_function(tg.name, "operator_sensitivity")(P[None], qe[None])
+        for ref, others in ((dJ, (c[0][0],)), (dr, (c[1][0],))):
+            scale = np.maximum(np.max(np.abs(ref), axis=1, keepdims=True), 1e-300)
+            for o in others:
+                assert np.all(np.abs(np.reshape(o, ref.shape) - ref) <= 1e-12 * scale)
+        # rows' scale in relative units: the largest p_j dX/dp_j of the entry
+        rows_scale = np.maximum(np.max(np.abs(dJ[:, :npar] * P), axis=1), 1e-300)
+        for j in (tg.param_names.index("Kp"), tg.param_names.index("H"), tg.param_names.index("phi")):
+            h = 1e-6 * P[j]
+            Pp, Pm = P.copy(), P.copy()
+            Pp[j] += h
+            Pm[j] -= h
+            fd = (np.concatenate([np.ravel(X) for X in tg.numpy.operator(Pp, qe)])
+                  - np.concatenate([np.ravel(X) for X in tg.numpy.operator(Pm, qe)])) / (Pp[j] - Pm[j])
+            assert np.all(np.abs(dJ[:, j] - fd) * abs(P[j]) <= 1e-8 * rows_scale), j
+        assert dJ.shape[1] == npar + len(qe)

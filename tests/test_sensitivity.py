@@ -170,6 +170,12 @@ def test_cli_contract(tg, nominal):
     assert abs(rel[i8, tg.param_names.index("Kp")] - 0.5) < 1e-6 and abs(rel[i8, tg.param_names.index("m")] + 0.5) < 1e-6
     rc, out, err = run_cli("frequencies", MODEL, "--sensitivities")
     assert rc == 0 and "relative sensitivities" in out
+
+
+def test_tornado_chart(nominal, tmp_path):
+    out = tmp_path / "tornado.png"
+    nominal.tornado(out, modes=[0, 7], title="two modes")
+    assert out.stat().st_size > 5_000
     rc, out, err = run_cli("frequencies", MODEL, "--sensitivities", "--method", "formulas")
     assert rc == 2 and "--sensitivities" in err and len(err.strip().splitlines()) == 1
 

@@ -154,6 +154,11 @@ def test_double_roots_of_a_spectrum():
     # two roots closer than ten times their error estimates cannot be told apart either
     spec = Spectrum("default", f, np.zeros_like(f), np.full(f.shape, 0.02))
     assert double_roots(spec)[1].tolist() == [True, True, False]
+    # an exact zero root (u = 0: a free azimuth, estimate 1) is double with its mirror; its
+    # error (1 x 0) leaves the other roots theirs
+    z = np.array([[0.0, 5.07, 7.83]])
+    spec = Spectrum("default", z, np.zeros_like(z), np.array([[1.0, 1e-14, 1e-14]]))
+    assert double_roots(spec).tolist() == [[True, False, False]]
 
 
 def test_cli_contract(tg, nominal):

@@ -19,7 +19,7 @@ measures which is faster.
 A double or nearly double root has no derivative (it is not differentiable where two roots
 meet, and first order holds only for moves far below their distance): a root closer than
 DOUBLE, relative, to another root of the spectrum (or to its own mirror -lambda, a root
-near zero), or closer than ten times the two roots' error estimates, is reported as such
+near zero), or closer than ten times the sum of the two roots' errors, is reported as such
 (`double`), with NaN in place of a number; so is a root without a finite frequency."""
 from __future__ import annotations
 
@@ -128,6 +128,21 @@ def _null_vectors(M, D, K, lam, hermitian):
     return x, y
 
 
+def _equilibrium_derivative(drq, drp):
+    """dq_e/dp = -(dr/dq_e)^-1 dr/dp per set; NaN for a set whose dr/dq_e is singular (its
+    equilibrium does not depend smoothly on p: no sensitivity), not the whole batch."""
+    try:
+        return -np.linalg.solve(drq, drp)
+    except np.linalg.LinAlgError:
+        out = np.full(drp.shape, np.nan)
+        for i in range(drq.shape[0]):
+            try:
+                out[i] = -np.linalg.solve(drq[i], drp[i])
+            except np.linalg.LinAlgError:
+                pass
+        return out
+
+
 def double_roots(spec: Spectrum) -> np.ndarray:
     """(sets, modes): the roots that are double or nearly so (module docstring)."""
     lam = spec.growth + 1j * spec.frequencies
@@ -138,7 +153,8 @@ def double_roots(spec: Spectrum) -> np.ndarray:
                          np.abs(lam[:, :, None] + np.conj(lam[:, None, :])))  # the mirror image too
         n = lam.shape[1]
         gap[:, np.arange(n), np.arange(n)] = 2 * np.abs(lam)  # its own mirror -lambda: a root near zero
-        close = (gap < DOUBLE * mag[:, :, None]) | (gap < 10 * (est[:, :, None] + est[:, None, :]) * mag[:, :, None])
+        err = est * mag  # absolute error of each root
+        close = (gap < DOUBLE * mag[:, :, None]) | (gap < 10 * (err[:, :, None] + err[:, None, :]))
     return close.any(axis=2) | ~np.isfinite(lam) | (spec.frequencies <= 0)
 
 
@@ -162,7 +178,7 @@ def _chunk(model: Model, P: np.ndarray, spec: Spectrum, route: str) -> np.ndarra
     live = np.flatnonzero(np.any(dJ != 0, axis=(0, 2)))
     dJ = dJ[:, live]
     with np.errstate(all="ignore"):
-        dq = -np.linalg.solve(drq, drp) if nq else np.zeros((k.size, 0, npar))
+        dq = _equilibrium_derivative(drq, drp) if nq else np.zeros((k.size, 0, npar))
         total = dJ[:, :, :npar] + dJ[:, :, npar:] @ dq  # (sets, live entries, params)
     which, entry = np.divmod(live, n * n)
     row, col = np.divmod(entry, n)

@@ -74,7 +74,12 @@ def client(scheduler):
         cluster = LocalCluster(n_workers=max(1, os.cpu_count() or 1), threads_per_worker=1, processes=True,
                                dashboard_address=None)
         return Client(cluster)
-    return Client(scheduler, timeout="10s")
+    try:
+        return Client(scheduler, timeout="10s")
+    except (OSError, ValueError, TypeError) as exc:  # TimeoutError is an OSError
+        from gyro.errors import ParameterError
+
+        raise ParameterError(f"--scheduler {scheduler!r}: no Dask scheduler answers there ({exc})") from None
 
 
 def _warm_on(c, warm, workers, *args) -> None:

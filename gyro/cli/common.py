@@ -62,6 +62,12 @@ def add_quiet(p) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bar (none either when stderr is not a terminal)")
 
 
+def add_scheduler(p) -> None:
+    p.add_argument("--scheduler", default=None, metavar="local|ADDRESS",
+                   help="run the chunks on Dask: 'local' starts a local cluster of one worker per core; "
+                        "an address (tcp://host:8786) uses a running scheduler (default: this process)")
+
+
 def parse_sets(items: list[str]) -> dict[str, str]:
     """NAME=VALUE items into a dict (values still text: the model checks them)."""
     out = {}

@@ -17,6 +17,9 @@ def register(sub) -> None:
     add_json(f)
     f.add_argument("--method", default="default", choices=method_names(),
                    help="rung of the ladder (default: %(default)s; docs/methods.md)")
+    f.add_argument("--sensitivities", action="store_true",
+                   help="also d omega / d p of every frequency to every parameter (exact, with the "
+                        "equilibrium's own dependence), and relative: (p / omega) d omega / d p")
     f.set_defaults(run=run)
 
 
@@ -32,8 +35,21 @@ def run(args) -> int:
     spec = ladder.spectrum(model, model.vector(values), args.method)
     if not (np.all(np.isfinite(spec.frequencies[0])) and np.all(np.isfinite(spec.growth[0]))):
         raise FloatingPointError("a frequency is not finite")  # no verdict: exit 1, text and JSON alike
+    sens = None
+    if getattr(args, "sensitivities", False):
+        if args.method == "formulas":
+            raise ParameterError("--sensitivities: the formulas give no operator to differentiate; "
+                                 "use another --method")
+        from gyro.analyses.sensitivity import sensitivities
+
+        sens = sensitivities(model, model.vector(values), spec)
     if args.json:
-        print(json.dumps(spec.to_dict(0, model, values), allow_nan=False))
+        doc = spec.to_dict(0, model, values)
+        if sens is not None:
+            doc.update(sens.to_dict(0))
+        print(json.dumps(doc, allow_nan=False))
     else:
         print(spec.table(0, model))
+        if sens is not None:
+            print(sens.table(0))
     return 0

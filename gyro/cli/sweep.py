@@ -6,7 +6,7 @@ import json
 import math
 import sys
 
-from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_set, check_png_out,
+from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_scheduler, add_set, check_png_out,
                              model_with_equilibrium, parse_sets)
 from gyro.errors import ParameterError
 from gyro.methods import names as method_names
@@ -26,6 +26,7 @@ def register(sub) -> None:
     add_json(s)
     add_out(s, required=False, help="also plot the frequencies into FILE.png")
     add_quiet(s)
+    add_scheduler(s)
     s.set_defaults(run=run)
 
 
@@ -51,7 +52,7 @@ def run(args) -> int:
         raise ParameterError(f"--method formulas: {model.name} has no approximate formulas")
     out = check_png_out(args.out) if args.out else None
     result = sweep(model, values, args.x, lo, hi, args.points, args.method, args.x_log,
-                   progress=not args.quiet and sys.stderr.isatty())
+                   progress=not args.quiet and sys.stderr.isatty(), scheduler=args.scheduler)
     if out is not None:
         result.plot(out)
     if args.json:

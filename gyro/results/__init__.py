@@ -12,6 +12,8 @@ One module per kind of result; every name is importable from `gyro.results`.
 - `gyrohorizoncompass`: `EquilibriumStability`, `ConditionMap`, `AngleTrajectory`;
 - `verdict`: `Verdict`, the one verdict type (stable, marginal, unstable, boundary,
   unknown, failed, each with its reason) and the two tests every analysis reads it through;
+- `sensitivity`: `Sensitivities` (d omega / d p of every frequency and parameter);
+- `tolerance`: `ToleranceStudy` (frequency distributions over manufacturing spreads);
 - `_io`: atomic saving of arrays and figures, shared by all.
 """
 from __future__ import annotations
@@ -20,11 +22,13 @@ from gyro.results._io import TMP_TAG, save_figure
 from gyro.results.campbell import FORMULA_BAD, CampbellDiagram
 from gyro.results.gyrohorizoncompass import AngleTrajectory, ConditionMap, EquilibriumStability
 from gyro.results.spectrum import ModalResult, Spectrum, Stability, classify, nearest_error
+from gyro.results.sensitivity import Sensitivities
 from gyro.results.stability_map import StabilityMap
 from gyro.results.sweep import FrequencySweep
+from gyro.results.tolerance import ToleranceStudy
 from gyro.results.trajectory import Trajectory
 from gyro.results.verdict import Verdict
 
 __all__ = ["TMP_TAG", "save_figure", "FORMULA_BAD", "CampbellDiagram", "AngleTrajectory", "ConditionMap",
            "EquilibriumStability", "ModalResult", "Spectrum", "Stability", "classify", "nearest_error",
-           "StabilityMap", "FrequencySweep", "Trajectory", "Verdict"]
+           "StabilityMap", "FrequencySweep", "Trajectory", "Verdict", "Sensitivities", "ToleranceStudy"]

@@ -113,3 +113,13 @@ def _finite_or_none(a) -> list:
     """Rows of numbers for strict JSON: a value that could not be computed is null."""
     return [[float(v) if np.isfinite(v) else None for v in row] for row in np.asarray(a, float)]
 
+
+
+def mode_panels(plt, n: int, height: float):
+    """A figure of n panels, one a mode, five to a row; unused panels hidden."""
+    cols = min(n, 5)
+    rows = -(-n // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(3.1 * cols, height * rows), layout="constrained", squeeze=False)
+    for ax in axes.flat[n:]:
+        ax.axis("off")
+    return fig, axes

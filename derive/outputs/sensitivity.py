@@ -1,0 +1,27 @@
+"""Parameter derivatives of the exact operator and of the equilibrium equations: the
+pieces of the eigenvalue derivative d lambda / d p_j = -(y* dJ/dp_j x) / (y* J'(lambda) x),
+with the equilibrium's own dependence dq_e/dp_j = -(dr/dq_e)^-1 dr/dp_j included by the
+runtime (gyro/analyses/sensitivity.py)."""
+from __future__ import annotations
+
+import sympy as sp
+
+from derive.model import Function
+
+ORDER = 25
+
+
+def functions(d) -> list[Function]:
+    if d.momenta:  # a stationary motion's operator: its reference is not an equilibrium of p alone
+        return []
+    op = d.operator
+    wrt = list(d.model.symbols) + list(d.even)
+    entries = [e for X in (op.M, op.D, op.K) for e in X]  # row-major M, then D, then K
+    dJ = sp.Matrix([[sp.diff(e, w) for w in wrt] for e in entries])
+    dr = d.equilibrium_residual.jacobian(wrt)
+    names = ", ".join(str(w) for w in wrt)
+    return [Function("operator_sensitivity", d.state(),
+                     [("dMDK", dJ), ("dr", dr)],
+                     "Jacobians with respect to (" + names + "): dMDK of the entries of M, D and K "
+                     "(row-major, M then D then K; one row an entry) and dr of the equilibrium "
+                     "residual (one row an equation).", ("dMDK", "dr"))]

@@ -1,0 +1,264 @@
+"""Tolerance analysis: the distribution of every natural frequency when parameters are made
+to a tolerance, first order from the exact sensitivities and sampled, side by side.
+
+A spread is relative to the parameter's nominal value: normal with standard deviation
+SIGMA, or uniform within +-HALFWIDTH; spreads may be correlated (a Gaussian copula: the
+correlated standard normals z = L e, L the Cholesky factor of the correlation matrix; a
+uniform parameter takes Phi(z)). Sampling runs over the sweep executor (gyro.executor) in
+chunks of CHUNK samples; the samples of chunk c come from the generator seeded with
+(seed, c), so that a chunk is a pure function of its inputs and any executor gives the
+same bits. The frequencies are the default method's (the model hierarchy's selector of
+the cheapest adequate level is not in this tree yet). A sample outside a parameter's
+valid range, or without an answer, is counted in `failed`, never dropped silently.
+
+First order: std_i = sqrt(S_i C S_i^T), S the sensitivities at the nominal set, C the
+covariance of the parameters (the copula's correlation carried to uniform marginals:
+(6/pi) asin(rho/2) between two uniforms, rho sqrt(3/pi) between a normal and a uniform).
+
+The band probability: the chance that omega_i falls within +-band (relative) of a
+harmonic k omega_c of the rotor's spin rate omega_c = H / C (a model with the parameters
+H, the rotor's angular momentum, and C, its polar moment), sampled, and to first order
+from the sensitivities of omega_i - k omega_c."""
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from gyro import executor, ladder
+from gyro.analyses.sweep import model_ref, warm
+from gyro.errors import ParameterError
+from gyro.models import Model, load
+from gyro.results import ToleranceStudy
+
+CHUNK = 4096  # samples per chunk: the unit of work, of retry and of the random streams
+QUANTILES = (0.01, 0.5, 0.99)
+BINS = 60
+IN_MEMORY = 1 << 28  # bytes: larger results go to .npy memory maps on disk
+
+
+@dataclass(frozen=True)
+class Spread:
+    name: str
+    kind: str  # "normal" or "uniform"
+    width: float  # relative: sigma, or the half-width
+
+    @property
+    def std(self) -> float:
+        """Relative standard deviation."""
+        return self.width if self.kind == "normal" else self.width / np.sqrt(3.0)
+
+
+def parse_spread(text: str) -> Spread:
+    name, sep, rest = text.partition("=")
+    kind, sep2, width = rest.partition(":")
+    if not sep or not sep2 or kind not in ("normal", "uniform"):
+        raise ParameterError(f"--spread {text!r}: expected NAME=normal:SIGMA or NAME=uniform:HALFWIDTH")
+    try:
+        w = float(width)
+    except ValueError:
+        raise ParameterError(f"--spread {text!r}: {width!r} is not a number") from None
+    if not (np.isfinite(w) and 0 < w < 1):
+        raise ParameterError(f"--spread {name}: the relative width must lie in (0, 1), got {width}")
+    return Spread(name.strip(), kind, w)
+
+
+def copula_correlation(spreads: list[Spread], corr: np.ndarray) -> np.ndarray:
+    """The correlation of the parameters themselves from that of the copula's normals."""
+    c = corr.copy()
+    for i, a in enumerate(spreads):
+        for j, b in enumerate(spreads):
+            if i == j:
+                continue
+            if a.kind == b.kind == "uniform":
+                c[i, j] = 6 / np.pi * np.arcsin(corr[i, j] / 2)
+            elif a.kind != b.kind:
+                c[i, j] = corr[i, j] * np.sqrt(3 / np.pi)
+    return c
+
+
+def correlation(spreads: list[Spread], pairs: dict) -> np.ndarray:
+    """The copula's correlation matrix from {(A, B): rho}; positive definite or refused."""
+    names = [s.name for s in spreads]
+    c = np.eye(len(spreads))
+    for (a, b), rho in pairs.items():
+        for x in (a, b):
+            if x not in names:
+                raise ParameterError(f"--correlate {a},{b}: {x} has no --spread")
+        if a == b or not -1 < rho < 1:
+            raise ParameterError(f"--correlate {a},{b}={rho}: need two parameters and -1 < RHO < 1")
+        i, j = names.index(a), names.index(b)
+        c[i, j] = c[j, i] = rho
+    if np.min(np.linalg.eigvalsh(c)) <= 1e-12:
+        raise ParameterError("--correlate: the correlations are not positive definite (no such joint spread)")
+    return c
+
+
+def spin_rate(model: Model, P: np.ndarray) -> np.ndarray | None:
+    """omega_c = H / C per set, or None for a model without both parameters."""
+    if not {"H", "C"} <= set(model.param_names):
+        return None
+    return P[:, model.param_names.index("H")] / P[:, model.param_names.index("C")]
+
+
+def samples(nominal, index, relwidth, uniform, chol, seed, start, stop, chunk=CHUNK):
+    """The parameter sets start..stop of the study (start a multiple of `chunk`)."""
+    from scipy.special import ndtr
+
+    rng = np.random.default_rng([seed, start // chunk])
+    z = rng.standard_normal((chunk, len(index)))[: stop - start] @ chol.T
+    dev = np.where(uniform, 2 * ndtr(z) - 1, z) * relwidth
+    P = np.tile(nominal, (stop - start, 1))
+    P[:, index] *= 1 + dev
+    return P
+
+
+def valid(model: Model, P: np.ndarray) -> np.ndarray:
+    """Sets whose every parameter is within its valid range (Param.check, vectorised)."""
+    ok = np.all(np.isfinite(P), axis=1)
+    for j, p in enumerate(model.params):
+        v = P[:, j]
+        if p.kind == "positive":
+            ok &= v > 0
+        elif p.kind == "nonnegative":
+            ok &= v >= 0
+        lo, hi = p.bounds
+        if lo is not None:
+            ok &= v >= lo
+        if hi is not None:
+            ok &= v <= hi
+    return ok
+
+
+def chunk(start, stop, model_ref, nominal, index, relwidth, uniform, chol, seed, size=CHUNK):
+    """One chunk of the study: the samples' frequencies (NaN where failed) and spin rates."""
+    model = load(model_ref)
+    P = samples(nominal, index, relwidth, uniform, chol, seed, start, stop, size)
+    ok = valid(model, P)
+    n = len(model.meta["reduced"])
+    freq = np.full((stop - start, n), np.nan)
+    if ok.any():
+        spec = ladder.spectrum(model, P[ok], "default")
+        freq[ok] = spec.frequencies
+    spin = spin_rate(model, P)
+    out = {"frequencies": freq}
+    if spin is not None:
+        out["spin"] = spin
+    return out
+
+
+def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: int = 0,
+              pairs: dict | None = None, scheduler=None, harmonics=(), band: float = 0.02,
+              store: Path | None = None, progress: bool = False, size: int = CHUNK) -> ToleranceStudy:
+    """The study over n samples; `size` samples a chunk (with the seed, it fixes the
+    samples: chunk c draws from the generator seeded with (seed, c))."""
+    from gyro.analyses.sensitivity import sensitivities
+
+    names = [s.name for s in spreads]
+    for s in spreads:
+        if s.name not in model.param_names:
+            raise ParameterError(f"--spread {s.name}: unknown parameter; known: {' '.join(model.param_names)}")
+        if values[s.name] == 0:
+            raise ParameterError(f"--spread {s.name}: its value is 0, so a relative spread moves nothing")
+    if len(set(names)) != len(names):
+        raise ParameterError("--spread: a parameter is given twice")
+    if harmonics and spin_rate(model, model.vector(values)[None]) is None:
+        raise ParameterError(f"--harmonics: {model.name} has no spin rate H/C (parameters H and C)")
+    corr = correlation(spreads, pairs or {})
+    chol = np.linalg.cholesky(corr)
+    nominal = model.vector(values)
+    index = np.array([model.param_names.index(x) for x in names])
+    relwidth = np.array([s.width for s in spreads])
+    uniform = np.array([s.kind == "uniform" for s in spreads])
+    nomspec = ladder.spectrum(model, nominal, "default")
+    sens = sensitivities(model, nominal, nomspec)
+    # first order
+    sd = np.array([s.std for s in spreads]) * nominal[index]
+    cov = copula_correlation(spreads, corr) * np.outer(sd, sd)
+    S = sens.d[0][:, index]
+    first_std = np.sqrt(np.einsum("ij,jk,ik->i", S, cov, S))
+    nmodes = nomspec.frequencies.shape[1]
+    folder = store
+    tmp = None
+    if folder is None and n * (nmodes + 1) * 8 > IN_MEMORY:
+        tmp = tempfile.TemporaryDirectory(prefix="gyro-tolerance-")
+        folder = Path(tmp.name)
+    try:
+        ref = model_ref(model)
+        out = executor.run(chunk, n, size, (ref, nominal, index, relwidth, uniform, chol, seed, size), scheduler,
+                           folder, progress, "tolerance", warm=warm, warm_args=(ref,))
+        F = out["frequencies"]
+        ok = np.all(np.isfinite(F), axis=1)
+        stats = _stats(F, ok)
+        bands = None
+        if harmonics:
+            spin = out["spin"]
+            bands = _bands(F, ok, spin, harmonics, band, nomspec.frequencies[0], sens.d[0], model, nominal, cov,
+                           index)
+    finally:
+        if tmp is not None:
+            del F, out
+            tmp.cleanup()
+    return ToleranceStudy(model.name, model.meta["title"], n, seed, [s.__dict__ for s in spreads],
+                          {f"{a},{b}": r for (a, b), r in (pairs or {}).items()},
+                          nomspec.frequencies[0], sens, index, first_std, int(np.sum(~ok)), *stats,
+                          harmonics=list(harmonics), band=band, band_probability=bands,
+                          method="default")
+
+
+def _stats(F, ok):
+    """Per mode over the sets with an answer: mean, std, quantiles, histogram."""
+    nm = F.shape[1]
+    mean, std, skew = np.full(nm, np.nan), np.full(nm, np.nan), np.full(nm, np.nan)
+    q = np.full((nm, len(QUANTILES)), np.nan)
+    counts, edges = np.zeros((nm, BINS), int), np.zeros((nm, BINS + 1))
+    kurt = np.full(nm, np.nan)
+    idx = np.flatnonzero(ok)
+    for i in range(nm):
+        if idx.size == 0:
+            break
+        col = np.asarray(F[:, i])[idx]  # one column at a time: a memory map is read in strides
+        mean[i] = col.mean()
+        dev = col - mean[i]
+        std[i] = np.sqrt(np.mean(dev**2) * idx.size / max(idx.size - 1, 1))
+        if std[i] > 0:
+            skew[i] = np.mean(dev**3) / std[i] ** 3
+            kurt[i] = np.mean(dev**4) / std[i] ** 4
+        q[i] = np.quantile(col, QUANTILES)
+        lo, hi = np.quantile(col, (0.0005, 0.9995))
+        if not hi > lo:
+            lo, hi = col.min() - 0.5, col.max() + 0.5
+        counts[i], edges[i] = np.histogram(col, bins=BINS, range=(lo, hi))
+    return mean, std, skew, kurt, q, counts, edges
+
+
+def _bands(F, ok, spin, harmonics, band, nominal_freq, dfreq, model, nominal, cov, index):
+    """[mode][harmonic]: sampled probability of |omega_i / (k omega_c) - 1| < band, and the
+    first-order one (a normal omega_i - k omega_c)."""
+    from scipy.special import ndtr
+
+    iH, iC = model.param_names.index("H"), model.param_names.index("C")
+    wc0 = nominal[iH] / nominal[iC]
+    dwc = np.zeros(len(nominal))
+    dwc[iH], dwc[iC] = 1 / nominal[iC], -nominal[iH] / nominal[iC] ** 2
+    out = []
+    n_ok = max(int(ok.sum()), 1)
+    for i in range(F.shape[1]):
+        col = np.asarray(F[:, i])
+        row = []
+        for k in harmonics:
+            with np.errstate(invalid="ignore"):
+                inside = ok & (np.abs(col / (k * spin) - 1) < band)
+            # first order: x = omega_i - k omega_c normal with the linearised mean and std;
+            # the band |x| < band k omega_c taken at the nominal omega_c
+            g = dfreq[i][index] - k * dwc[index]
+            s = float(np.sqrt(g @ cov @ g))
+            mu = nominal_freq[i] - k * wc0
+            half = band * k * wc0
+            fo = (float(ndtr((half - mu) / s) - ndtr((-half - mu) / s)) if s > 0 else float(abs(mu) < half))
+            row.append({"harmonic": k, "omega": k * wc0, "probability": int(inside.sum()) / n_ok,
+                        "first_order_probability": fo})
+        out.append(row)
+    return out

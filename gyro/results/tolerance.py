@@ -1,0 +1,140 @@
+"""A tolerance study: the distribution of each natural frequency over manufacturing spreads,
+sampled and to first order, and the figures of it (histograms with the first-order normal
+overlaid)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gyro.results._io import _pyplot, mode_panels, save_figure
+from gyro.results.sensitivity import Sensitivities
+
+QUANTILE_LEVELS = (0.01, 0.5, 0.99)
+HOLDS = 0.05  # first order holds where its std is within 5 % of the sampled one (beyond sampling error)
+
+
+def _num(v):
+    return float(v) if v is not None and np.isfinite(v) else None
+
+
+@dataclass
+class ToleranceStudy:
+    model: str
+    title: str
+    samples: int
+    seed: int
+    spreads: list  # [{"name", "kind", "width"}]
+    correlations: dict  # {"A,B": rho}
+    nominal: np.ndarray  # (modes,) rad/s at the nominal set
+    sensitivities: Sensitivities  # at the nominal set
+    spread_index: np.ndarray  # indices of the spread parameters
+    first_order_std: np.ndarray  # (modes,)
+    failed: int
+    mean: np.ndarray
+    std: np.ndarray
+    skewness: np.ndarray
+    kurtosis: np.ndarray
+    quantiles: np.ndarray  # (modes, 3)
+    counts: np.ndarray  # (modes, bins)
+    edges: np.ndarray  # (modes, bins + 1)
+    harmonics: list = field(default_factory=list)
+    band: float = 0.02
+    band_probability: list | None = None
+    method: str = "default"
+
+    @property
+    def answered(self) -> int:
+        return self.samples - self.failed
+
+    def sampling_error(self) -> np.ndarray:
+        """Relative standard error of the sampled std: sqrt((kurtosis - 1) / (4 N))."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.sqrt((self.kurtosis - 1) / (4 * max(self.answered, 1)))
+
+    def first_order_error(self) -> np.ndarray:
+        """first_order_std / std - 1 per mode."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return self.first_order_std / self.std - 1
+
+    def first_order_holds(self) -> np.ndarray:
+        """Per mode: first order within HOLDS of the sampled std, beyond three standard
+        errors of sampling (a difference sampling cannot explain, larger than 5 %, is a
+        nonlinearity first order misses)."""
+        err = np.abs(self.first_order_error())
+        return err <= HOLDS + 3 * self.sampling_error()
+
+    def to_dict(self) -> dict:
+        """The `gyro tolerance --json` document (its keys are the contract)."""
+        holds = self.first_order_holds()
+        err, se = self.first_order_error(), self.sampling_error()
+        modes = []
+        for i in range(len(self.nominal)):
+            modes.append({"nominal": _num(self.nominal[i]), "mean": _num(self.mean[i]), "std": _num(self.std[i]),
+                          "quantiles": {str(q): _num(v) for q, v in zip(QUANTILE_LEVELS, self.quantiles[i])},
+                          "first_order_std": _num(self.first_order_std[i]),
+                          "first_order_error": _num(err[i]), "std_sampling_error": _num(se[i]),
+                          "first_order_holds": bool(holds[i]) if np.isfinite(err[i]) else None,
+                          "skewness": _num(self.skewness[i])})
+        doc = {"model": self.model, "samples": self.samples, "seed": self.seed, "method": self.method,
+               "spreads": self.spreads, "correlations": self.correlations, "frequencies": modes,
+               "sensitivities": self.sensitivities.to_dict(0)["sensitivities"],
+               "relative_sensitivities": self.sensitivities.to_dict(0)["relative_sensitivities"],
+               "sensitivity_parameters": list(self.sensitivities.param_names), "failed": self.failed}
+        if self.band_probability is not None:
+            doc["band"] = self.band
+            doc["band_probability"] = self.band_probability
+        return doc
+
+    def table(self) -> str:
+        lines = [f"{self.title} ({self.model}): {self.samples} samples (seed {self.seed}), "
+                 f"{self.failed} without an answer; method '{self.method}'",
+                 "spreads: " + ", ".join(f"{s['name']} {s['kind']} {100 * s['width']:g} %" for s in self.spreads),
+                 f"{'':>4} {'nominal':>12} {'mean':>12} {'std':>11} {'1st-order std':>13} {'q 0.01':>12} "
+                 f"{'q 0.99':>12}  first order"]
+        holds, err = self.first_order_holds(), self.first_order_error()
+        for i in range(len(self.nominal)):
+            verdict = ("holds" if holds[i] else "fails") + (f" ({100 * err[i]:+.1f} %)" if np.isfinite(err[i]) else "")
+            lines.append(f"{i + 1:>4} {self.nominal[i]:>12.6g} {self.mean[i]:>12.6g} {self.std[i]:>11.4g} "
+                         f"{self.first_order_std[i]:>13.4g} {self.quantiles[i, 0]:>12.6g} {self.quantiles[i, 2]:>12.6g}"
+                         f"  {verdict}")
+        if self.band_probability is not None:
+            ks = ", ".join(str(k) for k in self.harmonics)
+            lines.append(f"probability within +-{100 * self.band:g} % of a harmonic k omega_c, k = {ks} "
+                         "(sampled / first order):")
+            shown = 0
+            for i, row in enumerate(self.band_probability, 1):
+                cells = [f"k={b['harmonic']}: {b['probability']:.3g} / {b['first_order_probability']:.3g}" for b in row]
+                if any(b["probability"] > 0 or b["first_order_probability"] > 1e-6 for b in row):
+                    lines.append(f"{i:>4}   " + "   ".join(cells))
+                    shown += 1
+            if not shown:
+                lines.append("     none: every frequency stays clear (sampled 0, first order below 1e-6)")
+        return "\n".join(lines)
+
+    def plot(self, out, modes=None) -> None:
+        """Histograms of each frequency (relative to nominal) with the first-order normal."""
+        plt = _pyplot()
+        modes = list(range(len(self.nominal))) if modes is None else list(modes)
+        fig, axes = mode_panels(plt, len(modes), 2.5)
+        for ax, i in zip(axes.flat, modes):
+            w0 = self.nominal[i]
+            e = self.edges[i]
+            x = (e - w0) / w0 * 100
+            widths = np.diff(e)
+            dens = self.counts[i] / max(self.answered, 1) / widths
+            ax.stairs(dens * w0 / 100, x, fill=True, color="0.75", label="sampled")
+            s = self.first_order_std[i]
+            if np.isfinite(s) and s > 0:
+                grid = np.linspace(e[0], e[-1], 300)
+                pdf = np.exp(-0.5 * ((grid - w0) / s) ** 2) / (s * np.sqrt(2 * np.pi))
+                ax.plot((grid - w0) / w0 * 100, pdf * w0 / 100, color="tab:red", lw=1.2, label="first order")
+            ax.set_title(f"omega{i + 1} = {w0:.5g} rad/s", fontsize=9)
+            ax.tick_params(labelsize=7)
+            ax.set_yticks([])
+        axes.flat[0].legend(fontsize=7, loc="upper left")
+        fig.supxlabel("frequency change from nominal [%]", fontsize=9)
+        sp = ", ".join(f"{s['name']} {s['kind']} {100 * s['width']:g} %" for s in self.spreads)
+        fig.suptitle(f"{self.title}: {self.samples:,} samples; {sp}", fontsize=9)
+        save_figure(fig, out)
+        plt.close(fig)

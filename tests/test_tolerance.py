@@ -1,0 +1,100 @@
+"""Tolerance analysis (gyro/analyses/tolerance.py, `gyro tolerance`): first order against
+sampling, the samples' spreads and correlations, the band probability, and the
+command-line contract."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from gyro.analyses.tolerance import (copula_correlation, correlation, parse_spread, samples, tolerance)
+from gyro.models import load
+from tests.conftest import run_cli
+
+MODEL = "torsion_gyrocompass"
+N = 2048
+
+
+@pytest.fixture(scope="module")
+def tg():
+    return load(MODEL)
+
+
+@pytest.fixture(scope="module")
+def study(tg):
+    spreads = [parse_spread("Kp=normal:0.01"), parse_spread("Kgamma=uniform:0.02"), parse_spread("H=normal:0.005")]
+    return tolerance(tg, tg.defaults, spreads, N, seed=11, harmonics=(1,), band=0.02, size=1024)
+
+
+def test_first_order_against_sampling(study):
+    """With spreads of 1-2 % the frequencies are linear in the parameters to 1e-4 of the
+    spread (second-order terms are the spread squared), so the sampled std agrees with the
+    first-order one within sampling error: its relative standard error is
+    sqrt((kurtosis - 1) / 4N), 1.6 % for N = 2048 normal samples; four of them bound it.
+    The mean lies within four standard errors std / sqrt(N) of the nominal frequency."""
+    se = study.sampling_error()
+    assert np.all(np.abs(study.first_order_std / study.std - 1) <= 4 * se)
+    assert np.all(np.abs(study.mean - study.nominal) <= 4 * study.std / np.sqrt(N))
+    assert study.first_order_holds().all() and study.failed == 0
+    q = study.quantiles
+    assert np.all((q[:, 0] < q[:, 1]) & (q[:, 1] < q[:, 2]))
+
+
+def test_samples_have_the_spreads_and_correlations_asked():
+    spreads = [parse_spread("a=normal:0.1"), parse_spread("b=uniform:0.2"), parse_spread("c=uniform:0.3")]
+    corr = np.eye(3)
+    corr[0, 1] = corr[1, 0] = 0.6
+    corr[1, 2] = corr[2, 1] = -0.5
+    chol = np.linalg.cholesky(corr)
+    nominal = np.array([2.0, 3.0, 5.0])
+    P = samples(nominal, np.arange(3), np.array([0.1, 0.2, 0.3]), np.array([False, True, True]), chol, 1, 0,
+                100_000, chunk=100_000)
+    dev = P / nominal - 1
+    # 1e5 samples: standard errors of 0.3 % on a std and 0.003 on a correlation; bounds of four
+    assert abs(dev[:, 0].std() / 0.1 - 1) < 0.012
+    assert abs(dev[:, 1].std() / (0.2 / np.sqrt(3)) - 1) < 0.012
+    assert np.all(np.abs(dev[:, 1]) <= 0.2) and np.all(np.abs(dev[:, 2]) <= 0.3)  # uniform within the tolerance
+    expect = copula_correlation(spreads, corr)
+    got = np.corrcoef(dev.T)
+    assert np.all(np.abs(got - expect) < 0.012), (got, expect)
+
+
+def test_correlations_are_checked(tg):
+    spreads = [parse_spread("Kp=normal:0.05"), parse_spread("K0=normal:0.05"), parse_spread("m=normal:0.01")]
+    with pytest.raises(Exception, match="positive definite"):
+        correlation(spreads, {("Kp", "K0"): 0.9, ("K0", "m"): 0.9, ("Kp", "m"): -0.9})
+    with pytest.raises(Exception, match="has no --spread"):
+        correlation(spreads, {("Kp", "A"): 0.5})
+
+
+def test_band_probability(study):
+    """No mode of the paper's set lies within 2 % of the spin rate H/C = 2513 rad/s (the
+    nearest, omega9 = 1114 and omega10 = 3851, are 56 % and 53 % away, dozens of standard
+    deviations): both probabilities are zero."""
+    for row in study.band_probability:
+        assert row[0]["probability"] == 0 and row[0]["first_order_probability"] < 1e-12
+
+
+def test_cli_contract(tg, tmp_path):
+    out = tmp_path / "h.png"
+    rc, text, err = run_cli("tolerance", MODEL, "--spread", "Kp=normal:0.05", "--spread", "Kgamma=uniform:0.1",
+                            "--samples", "300", "--seed", "4", "--json", "--out", str(out), "--harmonics", "1,2")
+    assert rc == 0, err
+    doc = json.loads(text)
+    assert {"model", "samples", "seed", "frequencies", "sensitivities", "failed"} <= set(doc)
+    assert doc["model"] == MODEL and doc["samples"] == 300 and doc["seed"] == 4 and doc["failed"] == 0
+    mode = doc["frequencies"][0]
+    assert {"mean", "std", "quantiles", "first_order_std"} <= set(mode)
+    assert set(mode["quantiles"]) == {"0.01", "0.5", "0.99"}
+    assert len(doc["sensitivities"]) == len(doc["frequencies"]) and len(doc["sensitivities"][0]) == len(tg.param_names)
+    assert len(doc["band_probability"][0]) == 2
+    assert out.stat().st_size > 10_000
+    for bad, what in ((["--spread", "Kq=normal:0.05"], "Kq"), (["--spread", "Kp=gauss:0.05"], "--spread"),
+                      (["--spread", "Kp=normal:-1"], "--spread Kp"), (["--spread", "Kp=normal:0.05", "--samples", "0"], "--samples"),
+                      (["--spread", "Kp=normal:0.05", "--correlate", "Kp,K0=0.5"], "K0"),
+                      (["--spread", "Kp=normal:0.05", "--harmonics", "0"], "--harmonics"),
+                      (["--spread", "Kp=normal:0.05", "--out", str(tmp_path / "x.jpg")], "--out")):
+        args = ["tolerance", MODEL, *bad] + ([] if "--samples" in bad else ["--samples", "10"])
+        rc, text, err = run_cli(*args)
+        assert rc == 2 and what in err and len(err.strip().splitlines()) == 1 and text == "", (bad, err)

@@ -10,6 +10,7 @@ One module per kind of result; every name is importable from `gyro.results`.
 - `sweep`: `FrequencySweep` (frequencies against any one parameter);
 - `trajectory`: `Trajectory` (the gimbal's motion: closed form or an integrator);
 - `gyrohorizoncompass`: `EquilibriumStability`, `ConditionMap`, `AngleTrajectory`;
+- `scene`: `Scene` (a question answered at a tolerance by the cheapest adequate level);
 - `precession`: `ImagePointMotion` (the image point by one level of gimbal_precession);
 - `level_map`: `LevelMap` (one level's error against a more exact one over two parameters);
 - `_io`: atomic saving of arrays and figures, shared by all.
@@ -22,10 +23,11 @@ from gyro.results.gyrohorizoncompass import AngleTrajectory, ConditionMap, Equil
 from gyro.results.level_map import LevelMap
 from gyro.results.precession import ImagePointMotion
 from gyro.results.spectrum import ModalResult, Spectrum, Stability, classify, nearest_error
+from gyro.results.scene import Scene
 from gyro.results.stability_map import StabilityMap
 from gyro.results.sweep import FrequencySweep
 from gyro.results.trajectory import Trajectory
 
 __all__ = ["TMP_TAG", "save_figure", "FORMULA_BAD", "CampbellDiagram", "AngleTrajectory", "ConditionMap",
            "EquilibriumStability", "ModalResult", "Spectrum", "Stability", "classify", "nearest_error",
-           "StabilityMap", "FrequencySweep", "Trajectory", "LevelMap", "ImagePointMotion"]
+           "StabilityMap", "FrequencySweep", "Trajectory", "Scene", "LevelMap", "ImagePointMotion"]

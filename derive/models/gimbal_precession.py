@@ -26,11 +26,11 @@ Five levels of one hierarchy, each emitted (`quantities`):
   outer ring with its axial moment C3 (its transverse moments are neglected: they enter only
   through the products u_eta u_zeta of the base rate), the casing diag(B2, B1, B3) in x' y' z'
   (Avdonin's B1 about the casing axis eta1 = y', B3 about the spin axis), the rotor A1, A1, A3;
-- `rigorous`: (13) solved for alpha', beta', H' (`rigorous_rates`): the rotor's
-  momentum taken as H along z' (6), the rings' momenta neglected;
-- `image`: (21) in the image point x, y (`image_rates`), the same motion as `rigorous`;
-- `small`: (28) (`small_rates`): rho = 1, rho' = 0, c -> x, m_z' + l_z' -> m_z + l_z;
-- `elementary`: (30) H v_x = m_x + l_x, H v_y = m_y + l_y, H' = 0 (`elementary_rates`).
+- `rigorous`: (13) for alpha', beta', H' (`rigorous_system`: A r = b in the rates): the
+  rotor's momentum taken as H along z' (6), the rings' momenta neglected;
+- `image`: (21) in the image point x, y (`image_system`), the same motion as `rigorous`;
+- `small`: (28) (`small_system`): rho = 1, rho' = 0, c -> x, m_z' + l_z' -> m_z + l_z;
+- `elementary`: (30) H v_x = m_x + l_x, H v_y = m_y + l_y, H' = 0 (`elementary_system`).
 The image point of the casing axis z': x = c/c'' = tan(beta)/cos(alpha), y = c'/c'' =
 -tan(alpha) in the base axes (the frame xyz of the paper is the base here, omega = u).
 
@@ -195,18 +195,17 @@ def rigorous_equations(ad=alpha_d, bd=beta_d, Hnow=Hs, Hdot=H_d):
             Hdot - (m_z + Mo["M"])]
 
 
+def linear_system(equations, unknowns):
+    """(A, b) of equations linear in the unknowns (the rates), A rates = b: emitted as they
+    are (the friction moments carry the rates, so A is not diagonal), solved at run time
+    like the mass-matrix form of the full level."""
+    A, b = sp.linear_eq_to_matrix(equations, unknowns)
+    return A, b
+
+
 def _solve(equations, unknowns):
-    """The rates of equations linear in them: the first two (in the first two unknowns) by
-    Cramer's rule, no pivot that vanishes for some parameters (an elimination would divide
-    by a friction coefficient); the third has its unknown (H') alone, with coefficient 1."""
-    A, rhs = sp.linear_eq_to_matrix(equations, unknowns)
-    if A[2, 2] != 1 or any(A[k, 2] != 0 for k in range(2)):
-        raise ValueError("expected H' in the third equation only, with coefficient 1")
-    det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
-    r1 = (rhs[0] * A[1, 1] - A[0, 1] * rhs[1]) / det
-    r2 = (A[0, 0] * rhs[1] - rhs[0] * A[1, 0]) / det
-    r3 = rhs[2] - A[2, 0] * r1 - A[2, 1] * r2
-    return sp.Matrix([r1, r2, r3])
+    A, b = linear_system(equations, unknowns)
+    return A.LUsolve(b)
 
 
 def rigorous_rates():
@@ -311,17 +310,17 @@ CONDITIONS_29 = {f_alpha: 0, f_beta: 0, f_phi: 0, Mmotor: 0, k_xi1: 0, m_z: 0, l
 
 def quantities():
     angles, image, mom = ("angles", [alpha, beta]), ("image", [x, y]), ("momentum", [Hs])
-    return {
-        "rigorous_rates": (["params", angles, mom], [("rates", rigorous_rates())],
-                           "alpha', beta', H' of the rigorous precession equations (13) at alpha, beta "
-                           "and the rotor momentum H_t (level 'rigorous')."),
-        "image_rates": (["params", image, mom], [("rates", image_rates())],
-                        "x', y', H' of the rigorous image-point equations (21) with the third of (13) "
-                        "(level 'image')."),
-        "small_rates": (["params", image, mom], [("rates", small_rates())],
-                        "x', y', H' of the small-deviation equations (28) (level 'small')."),
-        "elementary_rates": (["params", image, mom], [("rates", elementary_rates())],
-                             "x', y', H' = 0 of the elementary equations (30) (level 'elementary')."),
+    systems = {"rigorous": (rigorous_equations, [alpha_d, beta_d, H_d], angles, "(13)"),
+               "image": (image_equations, [x_d, y_d, H_d], image, "(21) with the third of (13)"),
+               "small": (small_equations, [x_d, y_d, H_d], image, "(28) with the third of (13)"),
+               "elementary": (elementary_equations, [x_d, y_d, H_d], image, "(30), H' = 0")}
+    out = {}
+    for level, (eqs, unknowns, state, where) in systems.items():
+        A, b = linear_system(eqs(), unknowns)
+        out[f"{level}_system"] = (["params", state, mom], [("A", A), ("b", b)],
+                                  f"Level '{level}': {where} as A r = b in the rates r = "
+                                  f"({', '.join(map(str, unknowns))}).")
+    return {**out,
         "image_point": (["params", angles], [("xy", sp.Matrix(image_of()))],
                         "The image point (22): x = tan(beta)/cos(alpha), y = -tan(alpha)."),
         "angles_of_image": (["params", image], [("angles", sp.Matrix([ALPHA_OF, BETA_OF]))],
@@ -332,6 +331,38 @@ def quantities():
                                [("phi_d", sp.Matrix([Hs / A3 - casing_rate()[2]]))],
                                "phi' = H/A3 - omega_z': the full level's spin rate from the momentum."),
     }
+
+
+# seconds per set for a 10 s horizon, 401 points, with the bound (bench/precession.py,
+# bench/results/precession.json: the median CPU time of the evaluator)
+COSTS = {"elementary": 4.1e-3, "small": 5.2e-3, "rigorous": 4.6e-3, "image": 6.1e-3, "full": 0.62}
+NEGLECTS = {
+    "full": "the outer ring's transverse moments of inertia (products of the base rate only)",
+    "rigorous": "the rings' momenta and the rotor's transverse momentum: H along z' only (6)",
+    "image": "the same as rigorous: (21) is (13) written in the image point",
+    "small": "squares and products of x, y: rho = 1, rho' = 0, c = x, c' = y, m_z' + l_z' = m_z + l_z (24)-(27)",
+    "elementary": "all of (29): friction in the axes, the outer ring's imbalance, moments about the spin "
+                  "axis (H constant), and x, y small",
+}
+
+
+def levels():
+    """The five levels (docs/precession.md): each answers the motion of the image point over
+    a horizon, its bound the level's own estimate along its motion (gyro.analyses.precession:
+    the neglected moments integrated, twice, and the integrator's), edges the singular
+    casing angle."""
+    from derive.model import Bound, Level
+
+    valid = {"|beta0| < 90 deg (13) regular": sp.cos(beta0) - sp.Rational(1, 1000),
+             "|alpha0| < 90 deg (the image point in the plane)": sp.cos(alpha0) - sp.Rational(1, 1000)}
+    out = []
+    for name in ("elementary", "small", "rigorous", "image", "full"):
+        out.append(Level(name, NEGLECTS[name],
+                         {"kind": "trajectory", "analysis": "precession", "method": name, "quantities": ["x", "y"]},
+                         {"motion": Bound(estimate=True)}, valid=valid, cost=COSTS[name],
+                         reference=None if name == "full" else "full",
+                         doc=f"level '{name}' of the precession hierarchy"))
+    return out
 
 
 def build():
@@ -348,4 +379,5 @@ def build():
         steady={"phi": H / A3},
         identities={"kinematics (3)-(5) are the frames' angular velocities": kinematics_are_the_papers},
         quantities=quantities(),
+        levels=levels(),
     )

@@ -4,10 +4,12 @@ the five levels of its hierarchy integrated from one parameter set.
 Levels, most exact first (docs/precession.md):
 - `full`: the three-body Lagrange equations (generated `mass_matrix`, `forcing`), started
   on the precession: alpha'(0), beta'(0) those of (13), phi'(0) = H/A3 - omega_z';
-- `rigorous`: (13) in alpha, beta, H (`rigorous_rates`);
-- `image`: (21) in x, y, H (`image_rates`): the same motion as `rigorous`;
-- `small`: (28) (`small_rates`);
-- `elementary`: (30) (`elementary_rates`), H constant.
+- `rigorous`: (13) in alpha, beta, H (`rigorous_system`);
+- `image`: (21) in x, y, H (`image_system`): the same motion as `rigorous`;
+- `small`: (28) (`small_system`);
+- `elementary`: (30) (`elementary_system`), H constant.
+Each precession level is emitted as a linear system A r = b in its rates r (the friction
+moments carry the rates), solved at each step.
 Every level is integrated by CasADi's CVODES (Adams, rtol 1e-12) over the generated CasADi
 functions, one integrator per level built once with the parameters as its input.
 The image point and the angles are converted by the generated `image_point` and
@@ -65,7 +67,7 @@ def named(values: dict) -> dict:
 
 
 @lru_cache(maxsize=None)
-def _integrator(level: str, n_out: int):
+def _integrator(level: str, n_out: int, rtol_scale: float = 1.0):
     """A CVODES integrator of one level, parameters as its input p, outputs at n_out times
     of a grid scaled by its input: y(s) for s in [0, 1] with dy/ds = T f(y)."""
     import casadi as ca
@@ -79,13 +81,19 @@ def _integrator(level: str, n_out: int):
         rhs = ca.vertcat(y[3:], ca.solve(cf.mass_matrix(p, y[:3]), cf.forcing(p, y[:3], y[3:])))
     else:
         y = ca.SX.sym("y", 3)
-        fn = {"rigorous": cf.rigorous_rates, "image": cf.image_rates, "small": cf.small_rates,
-              "elementary": cf.elementary_rates}[level]
-        rhs = fn(p, y[:2], y[2])
+        A, b = getattr(cf, f"{level}_system")(p, y[:2], y[2])
+        rhs = ca.solve(A, b)
     grid = list(np.linspace(0.0, 1.0, n_out))
-    opts = {"abstol": ATOL, "reltol": RTOL, "max_num_steps": MAX_STEPS, "linear_multistep_method": "adams",
+    opts = {"abstol": ATOL * rtol_scale, "reltol": RTOL * rtol_scale, "max_num_steps": MAX_STEPS, "linear_multistep_method": "adams",
             "nonlinear_solver_iteration": "functional", "disable_internal_warnings": True}
     return ca.integrator(f"F_{level}", "cvodes", {"x": y, "p": P, "ode": T * rhs}, 0.0, grid, opts)
+
+
+def rates(level: str, P, state2, H_now) -> np.ndarray:
+    """The rates of a precession level at one state (angles or image point, and H) from its
+    emitted linear system A r = b."""
+    A, b = getattr(load(MODEL).numpy, f"{level}_system")(P, state2, [H_now])
+    return np.linalg.solve(A, b)
 
 
 def initial_state(level: str, values: dict) -> np.ndarray:
@@ -96,7 +104,7 @@ def initial_state(level: str, values: dict) -> np.ndarray:
         if abs(np.cos(ang)) < SINGULAR_COS:
             raise Singular(f"parameter {name}: at +-90 deg, where (13) is singular or the image point leaves the plane")
     if level == "full":
-        ad, bd, _ = nf.rigorous_rates(P, [a0, b0], [H0])
+        ad, bd, _ = rates("rigorous", P, [a0, b0], H0)
         (pd,) = nf.spin_from_momentum(P, [a0, b0], [ad, bd], [H0])
         return np.array([a0, b0, 0.0, ad, bd, pd])
     if level == "rigorous":
@@ -105,7 +113,7 @@ def initial_state(level: str, values: dict) -> np.ndarray:
     return np.array([x0, y0, H0])
 
 
-def simulate(values: dict, t, level: str):
+def simulate(values: dict, t, level: str, rtol_scale: float = 1.0):
     """The motion of one level at the times t (t[0] = 0): ImagePointMotion. Singular when it
     reaches beta or alpha = +-90 deg; FloatingPointError when the integrator fails."""
     import casadi as ca
@@ -119,7 +127,7 @@ def simulate(values: dict, t, level: str):
     P = vector(values)
     y0 = initial_state(level, values)
     T = float(t[-1])
-    F = _integrator(level, len(t))
+    F = _integrator(level, len(t), rtol_scale)
     c0 = time.process_time()
     try:
         Y = np.array(F(x0=y0, p=np.append(P, T))["xf"]).T
@@ -197,3 +205,91 @@ class Hierarchy:
 
 
 HIERARCHY = Hierarchy()
+
+
+# ----------------------------------------------------------------------------- the levels' bounds
+#
+# Each level's error against `full`, estimated along the level's own motion (docs/precession.md):
+# - the ring and rotor inertia that every precession level neglects: the full equations'
+#   residual r(t) = Mq q'' - f along the motion (q' from (13), q'' by differences), whose
+#   alpha, beta rows are the neglected inertia moments; a moment r moves the image point at
+#   |r|/H times |d(x, y)/d(alpha, beta)| <= rho^2;
+# - small and elementary: the difference of their rates from (21) along their motion;
+# - the integrator: the difference from the same level at a 100x looser tolerance.
+# Each defect integrated over the horizon is the first-order global error where the flow
+# does not amplify deviations (a turning base and a drift: it does not; friction contracts);
+# the bound is twice the sum, relative to the motion's largest excursion from its start.
+
+SAFETY = 2.0
+LOOSE = 100.0
+
+
+def _scale(m) -> float:
+    return float(np.hypot(m.x - m.x[0], m.y - m.y[0]).max())
+
+
+def _integral(t, f) -> float:
+    return float(np.sum((f[1:] + f[:-1]) * np.diff(t)) / 2)
+
+
+def inertia_defect(values: dict, m) -> np.ndarray:
+    """|r(t)| rho^2 / H along a precession motion m: the image point's rate error from the
+    moments of the rings' and the rotor's transverse inertia that (13) neglects."""
+    nf = load(MODEL).numpy
+    P = vector(values)
+    ab = np.stack([m.alpha, m.beta], axis=-1)
+    A, b = nf.rigorous_system(P, ab, m.H[:, None])
+    r3 = np.linalg.solve(A, b[..., None])[..., 0]
+    ad, bd = r3[:, 0], r3[:, 1]
+    pd = nf.spin_from_momentum(P, ab, np.stack([ad, bd], axis=-1), m.H[:, None])[:, 0]
+    q = np.stack([m.alpha, m.beta, np.zeros_like(m.t)], axis=-1)
+    qd = np.stack([ad, bd, pd], axis=-1)
+    qdd = np.gradient(qd, m.t, axis=0, edge_order=2)
+    Mq, f = nf.mass_matrix(P, q), nf.forcing(P, q, qd)
+    r = np.einsum("nij,nj->ni", Mq, qdd) - f
+    rho2 = 1 + m.x**2 + m.y**2
+    return np.hypot(r[:, 0], r[:, 1]) * rho2 / np.abs(m.H)
+
+
+def rate_defect(values: dict, m, level: str) -> np.ndarray:
+    """|(x', y') of (21) - those of `level`| along the level's motion m."""
+    nf = load(MODEL).numpy
+    P = vector(values)
+    xy, Hs = np.stack([m.x, m.y], axis=-1), m.H[:, None]
+    out = []
+    for lv in ("image", level):
+        A, b = getattr(nf, f"{lv}_system")(P, xy, Hs)
+        out.append(np.linalg.solve(A, b[..., None])[..., 0])
+    d = out[0] - out[1]
+    return np.hypot(d[:, 0], d[:, 1])
+
+
+def bound(values: dict, m) -> float:
+    """The relative error bound of motion m (one level's) against `full` (see above)."""
+    scale = _scale(m)
+    if not scale > 0:
+        return float("inf")
+    loose = simulate(values, m.t, m.level, rtol_scale=LOOSE)
+    integ = float(np.hypot(m.x - loose.x, m.y - loose.y).max())
+    if m.level == "full":
+        return integ / scale
+    defect = _integral(m.t, inertia_defect(values, m))
+    if m.level in ("small", "elementary"):
+        defect += _integral(m.t, rate_defect(values, m, m.level))
+    return (SAFETY * defect + integ) / scale
+
+
+BOUND_POINTS = 401
+
+
+def level_motion(model, P_row, method: str, horizon: float):
+    """The motion question's evaluator (gyro.questions.motion): (t, [x, y] over t, the
+    bound of each, '' or why the level cannot answer)."""
+    values = dict(zip(model.param_names, (float(v) for v in P_row)))
+    t = np.linspace(0.0, horizon, BOUND_POINTS)
+    try:
+        m = simulate(values, t, method)
+        b = bound(values, m)
+    except (ParameterError, FloatingPointError) as exc:
+        return t, None, None, str(exc)
+    return t, np.vstack([m.x, m.y]), np.array([b, b]), ""

@@ -31,8 +31,9 @@ LEVELS = ("full", "rigorous", "image", "small", "elementary")  # most exact firs
 CLI_NAMES = {"M_motor": "Mmotor"}  # the model file's CLI_NAMES (command line -> model symbol)
 SINGULAR_COS = 1e-3  # |cos beta| (or |cos alpha|) below this: at the singularity (|angle| > 89.94 deg)
 RTOL, ATOL = 1e-12, 1e-14
-MAX_STEPS = 2 * 10**6  # full: its nutation at H/J rad/s over an hour takes some 1e6 steps
-MAX_STEPS_PRECESSION = 10**5  # the precession levels' smooth motion: a few thousand an hour
+MAX_STEPS = 2 * 10**6  # full, between two output times: its nutation at H/J rad/s sets the step
+MAX_STEPS_PRECESSION = 10**4  # between two output times (CVODES counts per output interval); the precession
+# levels take a few hundred for an hour at rtol 1e-12, so more means the singularity at beta = +-90 deg
 
 
 class Singular(ParameterError):
@@ -85,7 +86,8 @@ def _integrator(level: str, n_out: int, rtol_scale: float = 1.0):
         A, b = getattr(cf, f"{level}_system")(p, y[:2], y[2])
         rhs = ca.solve(A, b)
     grid = list(np.linspace(0.0, 1.0, n_out))
-    opts = {"abstol": ATOL * rtol_scale, "reltol": RTOL * rtol_scale, "max_num_steps": MAX_STEPS if level == "full" else MAX_STEPS_PRECESSION, "linear_multistep_method": "adams",
+    steps = MAX_STEPS if level == "full" else MAX_STEPS_PRECESSION
+    opts = {"abstol": ATOL * rtol_scale, "reltol": RTOL * rtol_scale, "max_num_steps": steps, "linear_multistep_method": "adams",
             "nonlinear_solver_iteration": "functional", "disable_internal_warnings": True}
     return ca.integrator(f"F_{level}", "cvodes", {"x": y, "p": P, "ode": T * rhs}, 0.0, grid, opts)
 

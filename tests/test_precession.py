@@ -167,12 +167,12 @@ def test_elementary_fails_where_the_map_says(key):
     """The map's value at the two pinned points recomputed: equal to the committed one to
     1e-6 (the same integrators, deterministic; 1e-6 leaves rounding of the 1e-12 runs), one
     within tol 1e-2 and the other beyond it."""
-    g = BENCH["maps"][key]
     from bench.precession import MAPS
 
+    g = BENCH["maps"][key]
     sets = MAPS[key][2]
     inside, outside = PINNED[key]
-    t = np.linspace(0, 10.0, 201)
+    t = np.linspace(0, 10.0, pr.BOUND_POINTS)  # the motion question's samples
     for (i, j), want_inside in ((inside, True), (outside, False)):
         v = pr.parameters({**sets, g["x_name"]: g["x"][j], g["y_name"]: g["y"][i]})
         e = pr.image_error(pr.simulate(v, t, "elementary"), pr.simulate(v, t, "rigorous"))

@@ -86,7 +86,8 @@ def test_level_map_contract(tmp_path):
 
 @pytest.mark.parametrize("args,needle", [
     (["--level", "elementary", "--against", "small2"], "--against: unknown level 'small2'"),
-    (["--level", "rigorous", "--against", "elementary"], "must be more exact"),
+    (["--level", "rigorous", "--against", "rigorous"], "the same level"),
+    (["--level", "rigorous", "--against", "full", "--question", "frequencies"], "--question frequencies"),
     (["--level", "elementary", "--against", "rigorous", "--x", "k_xi1=1:0:3"], "need LO < HI"),
     (["--level", "elementary", "--against", "rigorous", "--x", "nope=0:1:3"], "unknown parameter"),
     (["--level", "elementary", "--against", "rigorous", "--tol", "2"], "--tol"),
@@ -102,7 +103,18 @@ def test_level_map_bad_input_exits_2(tmp_path, args, needle):
     assert len(err.strip().splitlines()) == 1 and needle in err and not out_png.exists()
 
 
-def test_level_map_of_a_model_without_levels_of_motion_exits_2(tmp_path):
+def test_level_map_is_generic_over_the_models_levels(tmp_path):
+    """The same command on the torsion gyrocompass's frequency levels: the formulas against
+    the exact operator."""
+    rc, out, err = run_cli("level-map", "torsion_gyrocompass", "--level", "formulas", "--against", "linear_exact",
+                           "--x", "u=5e-5:1e-4:2", "--y", "H=1:3:2", "--out", str(tmp_path / "t.png"), "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    assert d["against"] == "linear_exact:default" and "frequencies" in d["measure"]
+    assert all(0 < v < 1 for row in d["values"] for v in row)
+
+
+def test_level_map_of_a_model_without_levels_exits_2(tmp_path):
     rc, _, err = run_cli("level-map", "gimbal_gyroscope", "--level", "a", "--against", "b", "--x", "A0=1:2:2",
                          "--y", "B0=1:2:2", "--out", str(tmp_path / "m.png"))
     assert rc == 2 and "declares no levels" in err

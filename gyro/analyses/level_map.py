@@ -1,49 +1,22 @@
-"""The error of one level of a model's hierarchy against a more exact one, over a grid of two
-parameters (`gyro level-map`).
-
-Generic over models: a model's levels are offered by an analysis module that defines
-`HIERARCHY`, an object with `model`, `levels` (names, most exact first), `measure` (what
-the error measures), `parameters(sets)` (validated values from NAME=VALUE text),
-`units()`, `defaults()`, `answer(level, values, t_end)` and `error(answer, exact_answer)`
-(a relative error, NaN where it has no scale). The modules are found by reading the
-sources of gyro/analyses for a top-level `HIERARCHY =`, without importing them.
+"""The error of one level of a model's hierarchy against another over a grid of two
+parameters (`gyro level-map`): for any model that declares levels (docs/hierarchy.md) and
+any question both levels answer, the entry at each grid point is the largest relative error
+over the question's quantities, `gyro.analyses.scene.level_error`, the question's own
+measure (frequencies: relative to each frequency; motion: the largest deviation relative to
+the motion's largest excursion). Nothing here knows a model or a question by name.
 """
 from __future__ import annotations
 
-import importlib
 import math
-import pkgutil
 import time
-from pathlib import Path
 
 import numpy as np
 
+from gyro import levels as hierarchy
+from gyro import questions
 from gyro.errors import ParameterError, finite_number
 
-MAX_POINTS = 10**4  # grid points of one map (each integrates two levels)
-
-
-def providers() -> dict:
-    """model name -> analysis module that declares its hierarchy."""
-    import re
-
-    here = Path(__file__).parent
-    out = {}
-    for m in pkgutil.iter_modules([str(here)]):
-        src = (here / f"{m.name}.py").read_text() if (here / f"{m.name}.py").exists() else ""
-        if "\nHIERARCHY = " in src:
-            found = re.search(r'^MODEL = "([A-Za-z0-9_]+)"', src, re.M)
-            if found:
-                out[found.group(1)] = f"{__package__}.{m.name}"
-    return out
-
-
-def hierarchy(model: str):
-    known = providers()
-    if model not in known:
-        raise ParameterError(f"level-map: model {model!r} declares no levels; models with levels: "
-                             f"{', '.join(sorted(known)) or 'none'}")
-    return importlib.import_module(known[model]).HIERARCHY
+MAX_POINTS = 10**4  # grid points of one map
 
 
 def parse_axis(flag: str, text: str, names) -> tuple[str, float, float, int]:
@@ -67,29 +40,42 @@ def parse_axis(flag: str, text: str, names) -> tuple[str, float, float, int]:
     return name, lo, hi, n
 
 
-def check_levels(h, level: str, against: str) -> None:
+def question_of(model, level: str, against: str, question: str | None = None) -> str:
+    """The question both levels answer (`question`, or the first they share), checking the
+    levels: ParameterError naming --level, --against or --question."""
+    known = hierarchy.levels(model)
+    if not known:
+        raise ParameterError(f"level-map: {model.name} declares no levels")
+    names = [lv.name for lv in known] + sorted({lv.family for lv in known if lv.family})
     for flag, name in (("--level", level), ("--against", against)):
-        if name not in h.levels:
-            raise ParameterError(f"{flag}: unknown level {name!r} of {h.model}; known: {', '.join(h.levels)}")
-    if not h.levels.index(against) < h.levels.index(level):
-        raise ParameterError(f"--against {against}: must be more exact than --level {level} "
-                             f"(levels, most exact first: {', '.join(h.levels)})")
+        if name not in names:
+            raise ParameterError(f"{flag}: unknown level {name!r} of {model.name}; known: {', '.join(names)}")
+    a, r = hierarchy.get(model, level), hierarchy.get(model, against)
+    if a.name == r.name:
+        raise ParameterError(f"--against {against}: the same level as --level")
+    shared = [q for q in a.answers if q in r.answers and a.answers[q] is not None and r.answers[q] is not None]
+    if question is not None:
+        if question not in shared:
+            raise ParameterError(f"--question {question}: not answered by both {a.name} and {r.name}; "
+                                 f"they share: {', '.join(shared) or 'none'}")
+        return question
+    if not shared:
+        raise ParameterError(f"--against {against}: {a.name} and {r.name} answer no common question")
+    return shared[0]
 
 
-def level_map(h, level: str, against: str, xaxis, yaxis, sets: dict, t_end: float, tol: float,
-              progress: bool = False):
+def level_map(model, level: str, against: str, xaxis, yaxis, sets: dict, tol: float,
+              question: str | None = None, opts: dict | None = None, progress: bool = False):
     """LevelMap: the error of `level` against `against` at every point of the grid
-    (xaxis, yaxis: (name, lo, hi, n)), the other parameters from `sets`. Every point's
-    parameters are checked before anything is integrated (ParameterError naming the point);
-    a point where a level cannot be computed (a singular motion, a failed integration) is
-    NaN, its reason in `failed`."""
+    (xaxis, yaxis: (name, lo, hi, n)), the other parameters from `sets` (model names,
+    values checked: ParameterError naming the point); NaN where either level could not
+    answer (then `failed` says so)."""
+    from gyro.analyses.scene import level_error
     from gyro.results import LevelMap
 
-    check_levels(h, level, against)
+    q = question_of(model, level, against, question)
     if not (math.isfinite(tol) and 0 < tol < 1):
         raise ParameterError(f"--tol must lie in (0, 1), got {tol!r}")
-    if not (math.isfinite(t_end) and t_end > 0):
-        raise ParameterError(f"--t-end must be positive, got {t_end!r}")
     for ax in (xaxis, yaxis):
         if ax[0] in sets:
             raise ParameterError(f"parameter {ax[0]}: is an axis; do not --set it")
@@ -98,35 +84,36 @@ def level_map(h, level: str, against: str, xaxis, yaxis, sets: dict, t_end: floa
     xs, ys = np.linspace(*xaxis[1:3], xaxis[3]), np.linspace(*yaxis[1:3], yaxis[3])
     if xs.size * ys.size > MAX_POINTS:
         raise ParameterError(f"--x, --y: {xs.size * ys.size} points; at most {MAX_POINTS}")
-    points = []
+    rows = []
     for yv in ys:
         for xv in xs:
             try:
-                points.append(h.parameters({**sets, xaxis[0]: xv, yaxis[0]: yv}))
+                rows.append(model.vector({**sets, xaxis[0]: xv, yaxis[0]: yv}))
             except ParameterError as exc:
                 raise ParameterError(f"at {xaxis[0]} = {xv:g}, {yaxis[0]} = {yv:g}: {exc}") from None
-    values = np.full((ys.size, xs.size), np.nan)
-    failed = {}
+    P = np.array(rows)
+    c0 = time.perf_counter()
+    err = np.full(P.shape[0], np.nan)
+    chunks = np.array_split(np.arange(P.shape[0]), max(1, min(P.shape[0], 50)))
     bar = None
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=len(points), desc=f"level-map {level} vs {against}", unit="pt", leave=False)
-    c0 = time.perf_counter()
-    for k, p in enumerate(points):
-        i, j = divmod(k, xs.size)
-        try:
-            e = h.error(h.answer(level, p, t_end), h.answer(against, p, t_end))
-            values[i, j] = e
-            if not math.isfinite(e):
-                failed[f"{i},{j}"] = "no scale: the exact level's answer does not move"
-        except (ParameterError, FloatingPointError, RuntimeError) as exc:
-            failed[f"{i},{j}"] = str(exc)
+        bar = tqdm(total=P.shape[0], desc=f"level-map {level} vs {against}", unit="pt", leave=False)
+    for idx in chunks:
+        e, _ = level_error(model, q, level, against, P[idx], opts)
+        with np.errstate(all="ignore"):
+            err[idx] = np.where(np.isnan(e).any(axis=1), np.nan, np.max(e, axis=1, initial=-np.inf))
         if bar is not None:
-            bar.update()
+            bar.update(idx.size)
     if bar is not None:
         bar.close()
-    defaults = h.defaults()
+    values = err.reshape(ys.size, xs.size)
+    failed = {f"{i},{j}": "a level could not answer here" for i, j in zip(*np.nonzero(~np.isfinite(values)))}
+    defaults = model.defaults
     changed = {k: float(v) for k, v in sets.items() if float(v) != defaults.get(k)}
-    return LevelMap(h.model, level, against, xaxis[0], yaxis[0], xs, ys, values, float(tol), h.measure,
-                    h.units(), changed, failed, time.perf_counter() - c0)
+    units = {p.name: p.unit for p in model.params}
+    measure = f"largest relative error of the {q} question over its quantities ({', '.join(questions.get(q).quantities(model, opts or {}))})"
+    return LevelMap(model.name, hierarchy.get(model, level).name, hierarchy.get(model, against).name,
+                    xaxis[0], yaxis[0], xs, ys, values, float(tol), measure, units, changed, failed,
+                    time.perf_counter() - c0)

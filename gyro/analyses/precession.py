@@ -177,37 +177,6 @@ def image_error(a, b) -> float:
     return float(d / scale) if scale > 0 else float("nan")
 
 
-MEASURE = "max |image point error| / max |displacement of the image point|"
-
-
-class Hierarchy:
-    """This model's levels for the generic analyses (gyro.analyses.level_map): the motion of
-    the image point over a horizon, and its error measure."""
-
-    model = MODEL
-    levels = LEVELS
-    measure = MEASURE
-
-    @staticmethod
-    def parameters(sets):
-        return parameters(sets)
-
-    @staticmethod
-    def units() -> dict:
-        return {cli_name(p.name): p.unit for p in load(MODEL).params}
-
-    @staticmethod
-    def defaults() -> dict:
-        return named(load(MODEL).defaults)
-
-    @staticmethod
-    def answer(level: str, values: dict, t_end: float, points: int = 201):
-        return simulate(values, np.linspace(0.0, t_end, points), level)
-
-    error = staticmethod(image_error)
-
-
-HIERARCHY = Hierarchy()
 
 
 # ----------------------------------------------------------------------------- the levels' bounds

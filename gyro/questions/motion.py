@@ -55,8 +55,16 @@ def answer(model, level, P, opts) -> Answer:
             series[k], times[k] = s, t
             finals[k] = s[:, -1]
             est[k] = np.inf if e is None else e
-    return Answer(finals, est, failed, {"series": np.array(series, dtype=object), "t": np.array(times, dtype=object),
-                                        "names": np.array([ev["quantities"]] * N, dtype=object)})
+    return Answer(finals, est, failed, {"series": _objects(series), "t": _objects(times),
+                                        "names": _objects([ev["quantities"]] * N)})
+
+
+def _objects(items) -> np.ndarray:
+    """One object per set (an array over time each), not a stacked array."""
+    out = np.empty(len(items), dtype=object)
+    for k, v in enumerate(items):
+        out[k] = v
+    return out
 
 
 def edges(model, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
@@ -68,6 +76,8 @@ def error(ans: Answer, ref: Answer) -> np.ndarray:
     err = np.full((N, nq), np.nan)
     for k in range(N):
         a, r = ans.extra["series"][k], ref.extra["series"][k]
+        a = None if a is None else np.asarray(a, dtype=float)
+        r = None if r is None else np.asarray(r, dtype=float)
         if a is None or r is None or a.shape != r.shape:
             continue
         scale = np.sqrt(((r - r[:, :1]) ** 2).sum(axis=0)).max()

@@ -157,7 +157,7 @@ class Level:
     evaluator: dict
     answers: dict
     valid: dict = field(default_factory=dict)
-    cost: float | None = None
+    cost: float | dict | None = None  # a dict {method: s} for a declaration of several methods
     reference: str | None = None
     doc: str = ""
 

@@ -7,9 +7,9 @@ which questions a level answers, its bound per quantity as a rule evaluated per 
 emitted expression, plus the evaluator's own estimate where declared), where the bound
 cannot be evaluated, and its measured cost. It knows no model and no question by name.
 
-One declaration may name several methods of the ladder ({"kind": "spectrum", "methods":
-[...]}): it stands for one level per method, named LEVEL:METHOD, each costing the
-method's COST. That is the ladder's axis of the hierarchy; the model approximations are
+One declaration may name several methods ({"kind": ..., "methods": [...]}): it stands for
+one level per method, named LEVEL:METHOD, each costing its entry of a declared cost
+{METHOD: s}, or, for a method of the frequency ladder, the method's COST. That is the ladder's axis of the hierarchy; the model approximations are
 the other.
 """
 from __future__ import annotations
@@ -62,8 +62,9 @@ def levels(model: Model) -> list[Level]:
             for m in methods:
                 e = {k: v for k, v in ev.items() if k != "methods"}
                 e["method"] = m
+                cost = d["cost"].get(m) if isinstance(d["cost"], dict) else d["cost"]
                 out.append(Level(f"{d['name']}:{m}", d["neglects"], e, d["answers"], tuple(d["valid"]),
-                                 None, d["reference"], d["doc"], d["name"], d))
+                                 cost, d["reference"], d["doc"], d["name"], d))
         else:
             out.append(Level(d["name"], d["neglects"], ev, d["answers"], tuple(d["valid"]),
                              d["cost"], d["reference"], d["doc"], d["name"], d))

@@ -20,14 +20,8 @@ from gyro import levels as hierarchy
 from gyro import questions
 from gyro.ladder import as_batch
 from gyro.results import Scene
-
-
-class ToleranceUnreachable(ArithmeticError):
-    """No level of the hierarchy promises the tolerance (at some set)."""
-
-
-def _reason_apriori(b: float, tol: float) -> str:
-    return f"a-priori bound {b:.2e} > {tol:.2e}" if np.isfinite(b) else "a-priori bound not finite"
+from gyro.results.scene import (ACCEPTED, APRIORI, BOUND, EDGE, FAILED, NOT_ANSWERED, QUESTION_EDGE,
+                                Trial)
 
 
 def select(model, question: str, P, tol: float, opts: dict | None = None, among: list | None = None) -> Scene:
@@ -54,52 +48,47 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
         raise ParameterError(f"question {question!r}: {model.name} declares no level that answers it")
     level = np.full(N, "", object)
     bound = np.full((N, len(idx)), np.inf)
-    tried = [[] for _ in range(N)]
-    docs = [{} for _ in range(N)]
-    best = [(np.inf, "") for _ in range(N)]
+    row = np.full(N, -1)
+    trials, answers = [], {}
     pending = np.arange(N)
     for lv in cands:
         if pending.size == 0:
             break
+        trial = Trial(lv.name, np.zeros(N, np.int8), np.full(N, np.nan), np.full(N, None, object))
+        trials.append(trial)
         B = hierarchy.bounds(model, lv, question, P[pending], nq)
         missing = [names[j] for j in idx if not B.answered[j]]
         if missing:  # the level does not answer a requested quantity: no set can take it
-            for k in pending:
-                tried[k].append((lv.name, f"does not answer {', '.join(missing)}"))
+            trial.code[pending], trial.missing = NOT_ANSWERED, ", ".join(missing)
             continue
         pre = B.apriori[:, idx].max(axis=1) if idx else np.zeros(pending.size)
-        hopeful = (B.invalid == "") & (pre <= tol)
-        for i, k in enumerate(pending):
-            if not hopeful[i]:
-                why = (f"edge of validity: {B.invalid[i]}" if B.invalid[i] else _reason_apriori(pre[i], tol))
-                tried[k].append((lv.name, why))
-                if B.invalid[i] == "" and pre[i] < best[k][0]:
-                    best[k] = (pre[i], lv.name)
+        beyond = B.invalid != ""
+        hopeful = ~beyond & (pre <= tol)
+        trial.code[pending[beyond]] = EDGE
+        trial.text[pending[beyond]] = B.invalid[beyond]
+        far = ~beyond & ~hopeful
+        trial.code[pending[far]], trial.value[pending[far]] = APRIORI, pre[far]
         sub = np.flatnonzero(hopeful)
         if sub.size == 0:
             continue
         ks = pending[sub]
         ans = q.answer(model, lv, P[ks], opts)
-        Bs = hierarchy.Bounds(B.apriori[sub], B.estimate, B.invalid[sub], B.answered)
-        total = Bs.total(ans.estimate)
+        total = hierarchy.Bounds(B.apriori[sub], B.estimate, B.invalid[sub], B.answered).total(ans.estimate)
         edge = q.edges(model, ans, total, idx)
         worst = total[:, idx].max(axis=1) if idx else np.zeros(sub.size)
-        ok = (ans.failed == "") & (edge == "") & (worst <= tol)
-        for i, k in enumerate(ks):
-            if ok[i]:
-                tried[k].append((lv.name, f"bound {worst[i]:.2e} <= {tol:.2e}"))
-                level[k] = lv.name
-                bound[k] = total[i, idx]
-                docs[k] = q.document(model, ans, i, idx)
-            else:
-                why = ans.failed[i] or edge[i] or (f"bound {worst[i]:.2e} > {tol:.2e}" if np.isfinite(worst[i])
-                                                   else "bound not finite")
-                tried[k].append((lv.name, why))
-                if not ans.failed[i] and not edge[i] and worst[i] < best[k][0]:
-                    best[k] = (worst[i], lv.name)
+        failed, crossed = ans.failed != "", edge != ""
+        ok = ~failed & ~crossed & (worst <= tol)
+        trial.value[ks] = worst
+        trial.code[ks] = np.where(ok, ACCEPTED, np.where(failed, FAILED, np.where(crossed, QUESTION_EDGE, BOUND)))
+        trial.text[ks[failed]] = ans.failed[failed]
+        trial.text[ks[~failed & crossed]] = edge[~failed & crossed]
+        level[ks[ok]] = lv.name
+        bound[ks[ok]] = total[ok][:, idx]
+        row[ks[ok]] = np.flatnonzero(ok)
+        answers[lv.name] = (q, model, ans, idx)
         pending = np.setdiff1d(pending, ks[ok], assume_unique=True)
-    return Scene(model.name, question, float(tol), [names[j] for j in idx], level, bound, tried, docs, best,
-                 time.perf_counter() - t0)
+    return Scene(model.name, question, float(tol), [names[j] for j in idx], level, bound, trials,
+                 time.perf_counter() - t0, answers, row)
 
 
 def level_error(model, question: str, level: str, against: str, P, opts: dict | None = None):

@@ -49,10 +49,22 @@ def run(args) -> int:
     from gyro.analyses.scene import select
     from gyro.models import load
 
+    from gyro import questions
+
     tol = _tol(args.tol)
     model = load(args.model)
-    values = model.parameters(parse_sets(args.set))
+    q = questions.get(args.question)
+    sets = parse_sets(args.set)
+    # a question's own inputs beside the model's parameters (the motion's initial conditions)
+    extra = q.initial_conditions(model) if hasattr(q, "initial_conditions") else {}
+    for key in sets:
+        if key not in model.param_names and key not in extra:
+            raise ParameterError(f"unknown parameter {key!r} for {model.name}; known: "
+                                 f"{' '.join([*model.param_names, *extra])}")
+    values = model.parameters({k: v for k, v in sets.items() if k not in extra})
     opts = {"modes": _modes(args.modes)}
+    if extra:
+        opts["initial"] = {k: finite_number(k, v) for k, v in sets.items() if k in extra}
     if args.modes is not None and args.question != "frequencies":
         raise ParameterError(f"--modes: only for the frequencies question, not {args.question!r}")
     if args.horizon is not None:
@@ -63,7 +75,7 @@ def run(args) -> int:
             raise ParameterError(f"--horizon: must be positive, got {args.horizon!r}")
     scene = select(model, args.question, model.vector(values), tol, opts)
     if not scene.answered[0]:
-        b, lv = scene.best[0]
+        b, lv = scene.best(0)
         offer = f"the best bound is {b:.2e} ({lv})" if lv else "no level gives a finite bound here"
         print(f"gyro: error: --tol {tol:g} is below what the hierarchy of {model.name} can promise "
               f"at this set; {offer}", file=sys.stderr)

@@ -107,9 +107,9 @@ def edges(model, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
     """'' per set, or the reason the bound is no promise there: two neighbouring modes
     (in rank, among all of them) whose intervals omega (1 +- bound) touch."""
     f = ans.values
-    lo, hi = f * (1 - bound), f * (1 + bound)
     out = np.full(f.shape[0], "", object)
     with np.errstate(invalid="ignore"):
+        lo, hi = f * (1 - bound), f * (1 + bound)
         touch = hi[:, :-1] >= lo[:, 1:]  # rank j and j + 1
     want = np.zeros(f.shape[1], bool)
     want[list(idx)] = True

@@ -1,13 +1,14 @@
-"""`motion`: a motion over a horizon (`--horizon T`, s): the quantities are the
-coordinates the level's analysis reports (its evaluator's `quantities`), each over time.
+"""`motion`: the motion over a horizon [0, T] (`--horizon`, s) from initial conditions; one
+quantity per coordinate (in the model's order), its relative error the largest deviation
+over the horizon divided by the coordinate's largest magnitude (at least 1 rad) there.
 
-Evaluator kind: `trajectory`, {"kind": "trajectory", "analysis": MODULE, "method": NAME,
-"quantities": [...]}: `gyro.analyses.MODULE.level_motion(model, P_row, method, horizon)`
-returns (t, series (quantities, times), estimate or None, failure reason or ''), the
-estimate the level's own relative error bound of the motion (docs/hierarchy.md).
-The error of a motion against another level's: max over t of |q - q_ref| over all
-quantities, relative to the largest excursion of q_ref from its start (the motion's own
-size); infinite where the reference does not move.
+Evaluator kind: `trajectory`, {"analysis": MODULE, "method": NAME, "rtol": R}: the module
+gyro.analyses.MODULE offers INITIAL (name -> (unit, default, description): the initial
+conditions, which `gyro scene` takes with --set), `Motion(params, **initial)` and
+`motion_answer(motion, t, method, rtol) -> (q (times, coordinates), absolute error
+estimate per coordinate)`. An evaluator that refuses a set (the closed form with C0 != 0)
+fails it with its reason, and the selector goes up. JSON keys: `horizon`, `t`, and one
+list per coordinate at the sample times.
 """
 from __future__ import annotations
 
@@ -18,53 +19,64 @@ import numpy as np
 from gyro.questions import Answer, unknown_kind
 
 NAME = "motion"
-DEFAULT_HORIZON = 10.0  # s
+POINTS = 201  # sample times over the horizon
+DEFAULT_HORIZON = 1.0  # s
 
 
-def _declared_quantities(model) -> list:
-    for d in model.meta.get("levels", []):
-        if "motion" in d["answers"] and d["evaluator"].get("kind") == "trajectory":
-            return list(d["evaluator"]["quantities"])
-    return []
+def _analysis(level):
+    return importlib.import_module(f"gyro.analyses.{level.evaluator['analysis']}")
+
+
+def initial_conditions(model) -> dict:
+    """name -> (unit, default, description) of every analysis the model's motion levels
+    name: the question's inputs beside the model's parameters."""
+    from gyro.levels import levels
+
+    out = {}
+    for lv in levels(model):
+        if lv.answers_question(NAME) and lv.evaluator.get("kind") == "trajectory":
+            out.update(_analysis(lv).INITIAL)
+    return out
 
 
 def quantities(model, opts) -> list[str]:
-    return _declared_quantities(model)
+    return list(model.meta["coordinates"])
 
 
 def requested(model, opts) -> list[int]:
-    return list(range(len(_declared_quantities(model))))
+    return list(range(len(model.meta["coordinates"])))
+
+
+def times(opts) -> np.ndarray:
+    return np.linspace(0.0, float(opts.get("horizon", DEFAULT_HORIZON)), int(opts.get("points", POINTS)))
 
 
 def answer(model, level, P, opts) -> Answer:
-    ev = level.evaluator
-    if ev.get("kind") != "trajectory":
+    if level.evaluator.get("kind") != "trajectory":
         raise unknown_kind(NAME, level)
-    mod = importlib.import_module(f"gyro.analyses.{ev['analysis']}")
-    horizon = float(opts.get("horizon") or DEFAULT_HORIZON)
-    nq = len(ev["quantities"])
-    N = P.shape[0]
-    finals = np.full((N, nq), np.nan)
-    est = np.full((N, nq), np.inf)
+    mod = _analysis(level)
+    t = times(opts)
+    init = {k: v[1] for k, v in mod.INITIAL.items()}  # (unit, default, description)
+    init.update(opts.get("initial", {}))
+    N, nc = P.shape[0], len(model.meta["coordinates"])
+    values = np.full((N, nc, t.size), np.nan)
+    est = np.full((N, nc), np.inf)
     failed = np.full(N, "", object)
-    series, times = [None] * N, [None] * N
     for k in range(N):
-        t, s, e, why = mod.level_motion(model, P[k], ev["method"], horizon)
-        failed[k] = why
-        if not why:
-            series[k], times[k] = s, t
-            finals[k] = s[:, -1]
-            est[k] = np.inf if e is None else e
-    return Answer(finals, est, failed, {"series": _objects(series), "t": _objects(times),
-                                        "names": _objects([ev["quantities"]] * N)})
-
-
-def _objects(items) -> np.ndarray:
-    """One object per set (an array over time each), not a stacked array."""
-    out = np.empty(len(items), dtype=object)
-    for k, v in enumerate(items):
-        out[k] = v
-    return out
+        params = dict(zip(model.param_names, map(float, P[k])))
+        ic = {n: float(np.broadcast_to(v, (N,))[k]) for n, v in init.items()}
+        try:
+            q, e = mod.motion_answer(mod.Motion(params, **ic), t, level.evaluator["method"],
+                                     level.evaluator.get("rtol", 1e-10))
+        except (ArithmeticError, ValueError, RuntimeError) as exc:  # a refusal or a failure: its reason
+            failed[k] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            continue
+        values[k] = q.T
+        scale = np.maximum(np.max(np.abs(q), axis=0), 1.0)
+        est[k] = e / scale
+        if not np.all(np.isfinite(q)):
+            failed[k] = "the motion could not be computed"
+    return Answer(values, est, failed, {"t": np.broadcast_to(t, (N, t.size))})
 
 
 def edges(model, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
@@ -72,22 +84,14 @@ def edges(model, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
 
 
 def error(ans: Answer, ref: Answer) -> np.ndarray:
-    N, nq = ans.values.shape
-    err = np.full((N, nq), np.nan)
-    for k in range(N):
-        a, r = ans.extra["series"][k], ref.extra["series"][k]
-        a = None if a is None else np.asarray(a, dtype=float)
-        r = None if r is None else np.asarray(r, dtype=float)
-        if a is None or r is None or a.shape != r.shape:
-            continue
-        scale = np.sqrt(((r - r[:, :1]) ** 2).sum(axis=0)).max()
-        d = np.sqrt(((a - r) ** 2).sum(axis=0)).max()
-        err[k] = d / scale if scale > 0 else np.inf
-    return err
+    with np.errstate(all="ignore"):
+        scale = np.maximum(np.max(np.abs(ref.values), axis=2), 1.0)
+        return np.max(np.abs(ans.values - ref.values), axis=2) / scale
 
 
 def document(model, ans: Answer, k: int, idx) -> dict:
-    out = {"t": [float(v) for v in ans.extra["t"][k]], "horizon": float(ans.extra["t"][k][-1])}
-    for name, row in zip(ans.extra["names"][k], ans.extra["series"][k]):
-        out[name] = [float(v) for v in row]
+    t = ans.extra["t"][k]
+    out = {"horizon": float(t[-1]), "t": [float(x) for x in t]}
+    for j, c in enumerate(model.meta["coordinates"]):
+        out[c] = [float(x) for x in ans.values[k, j]]
     return out

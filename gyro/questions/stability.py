@@ -1,6 +1,8 @@
 """`stability`: the verdict on the equilibrium (stable, marginal, unstable) from the
 eigenvalues of the linearised motion; one quantity per root (|lambda|, ascending), whose
-relative bound decides whether the real parts can be told from zero.
+relative bound decides whether the real parts can be told from zero; a root the verdict
+counts as neutral (an exact zero root, or one not resolved from zero: gyro.results.classify)
+is a free direction, bounded by 0 here, since its error does not enter the verdict.
 
 Evaluator kind: `spectrum` (a method of the ladder that computes growth rates). A verdict
 is counted only where it is one: 'unknown' (an unbounded root) and 'failed' (a root not
@@ -41,7 +43,12 @@ def answer(model, level, P, opts) -> Answer:
     lam = np.abs(spec.growth + 1j * spec.frequencies)
     st = verdict(spec, opts.get("tol", 1e-9))
     failed = np.where(np.isin(st.label, NO_VERDICT), "no verdict (" + st.label.astype(str) + ")", "").astype(object)
-    return Answer(lam, spec.error_estimate, failed,
+    # a root the verdict counts as neutral (an exact zero root, or one not resolved from
+    # zero: classify) is a free direction; its relative error does not enter the verdict
+    est = np.asarray(spec.error_estimate, dtype=float)
+    neutral = (lam == 0) | (np.isfinite(est) & (est >= 0.5))
+    est = np.where(neutral, 0.0, est)
+    return Answer(lam, est, failed,
                   {"label": st.label, "growth_rate": st.growth_rate, "unstable_roots": st.unstable_roots,
                    "growth": spec.growth, "frequencies": spec.frequencies})
 

@@ -1,6 +1,6 @@
 """`python -m bench.precession`: the precession hierarchy of gimbal_precession (002).
 
-- the cost of each level (the motion question's evaluator, 10 s horizon, with its bound):
+- the cost of each level (the motion question's evaluator, 10 s horizon, 201 samples, with its bound):
   median CPU time of 5 runs, the numbers `derive/models/gimbal_precession.py` declares;
 - the orders: `small` against `image` over the image point's size A (fitted slope of the
   relative error, expected 2), `rigorous` against `full` over H with and without the base
@@ -46,15 +46,17 @@ MAP_T, MAP_TOL = 10.0, 1e-2
 
 
 def costs(reps: int = 5) -> dict:
-    m = load(pr.MODEL)
-    P = m.vector(pr.parameters({}))
+    from gyro.questions.motion import POINTS
+
+    mo = pr.Motion(pr.parameters({}))
+    t = np.linspace(0.0, 10.0, POINTS)
     out = {}
     for lv in pr.LEVELS:
-        pr.level_motion(m, P, lv, 10.0)  # build the integrators
+        pr.motion_answer(mo, t, lv)  # build the integrators
         ts = []
         for _ in range(reps):
             c0 = time.process_time()
-            pr.level_motion(m, P, lv, 10.0)
+            pr.motion_answer(mo, t, lv)
             ts.append(time.process_time() - c0)
         out[lv] = float(np.median(ts))
         print(f"cost {lv}: {out[lv]:.3g} s per set (10 s horizon, with its bound)", flush=True)
@@ -151,8 +153,9 @@ def main() -> int:
     import sys
 
     RESULTS.mkdir(exist_ok=True)
-    if sys.argv[1:] == ["--maps"]:  # the maps alone, into the committed results
+    if sys.argv[1:] == ["--maps"]:  # the costs and the maps alone, into the committed results
         data = json.loads((RESULTS / "precession.json").read_text())
+        data["costs"] = costs()
         data["maps"] = maps()
         (RESULTS / "precession.json").write_text(json.dumps(data, indent=1, allow_nan=False) + "\n")
         return 0

@@ -114,10 +114,10 @@ def test_level_map_is_generic_over_the_models_levels(tmp_path):
     assert all(0 < v < 1 for row in d["values"] for v in row)
 
 
-def test_level_map_of_a_model_without_levels_exits_2(tmp_path):
+def test_level_map_of_another_models_unknown_level_exits_2(tmp_path):
     rc, _, err = run_cli("level-map", "gimbal_gyroscope", "--level", "a", "--against", "b", "--x", "A0=1:2:2",
                          "--y", "B0=1:2:2", "--out", str(tmp_path / "m.png"))
-    assert rc == 2 and "declares no levels" in err
+    assert rc == 2 and "--level: unknown level 'a' of gimbal_gyroscope" in err
 
 
 def test_scene_picks_the_cheapest_adequate_theory():

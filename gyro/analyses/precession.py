@@ -251,17 +251,22 @@ def bound(values: dict, m) -> float:
     return (SAFETY * defect + integ) / scale
 
 
-BOUND_POINTS = 401
+INITIAL: dict = {}  # the initial state is the parameters' (alpha0, beta0, H): no extra conditions
 
 
-def level_motion(model, P_row, method: str, horizon: float):
-    """The motion question's evaluator (gyro.questions.motion): (t, [x, y] over t, the
-    bound of each, '' or why the level cannot answer)."""
-    values = dict(zip(model.param_names, (float(v) for v in P_row)))
-    t = np.linspace(0.0, horizon, BOUND_POINTS)
-    try:
-        m = simulate(values, t, method)
-        b = bound(values, m)
-    except (ParameterError, FloatingPointError) as exc:
-        return t, None, None, str(exc)
-    return t, np.vstack([m.x, m.y]), np.array([b, b]), ""
+class Motion:
+    """The motion question's input (gyro/questions/motion.py): a parameter set by the model's names."""
+
+    def __init__(self, params: dict):
+        self.params = params
+
+
+def motion_answer(motion: Motion, t, method: str, rtol: float = RTOL):
+    """The motion question's evaluator: the image point x, y at the times t (times, 2) and the
+    level's bound as an absolute error of each (its relative bound times the motion's largest
+    excursion, the scale the evaluator declares). Singular (a ValueError) where the motion
+    reaches beta or alpha = +-90 deg."""
+    m = simulate(motion.params, np.asarray(t, float), method)
+    b = bound(motion.params, m)
+    ex = _scale(m)
+    return np.stack([m.x, m.y], axis=-1), np.full(2, b * ex)

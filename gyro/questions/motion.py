@@ -9,6 +9,13 @@ conditions, which `gyro scene` takes with --set), `Motion(params, **initial)` an
 estimate per coordinate)`. An evaluator that refuses a set (the closed form with C0 != 0)
 fails it with its reason, and the selector goes up. JSON keys: `horizon`, `t`, and one
 list per coordinate at the sample times.
+
+Two options of the evaluator, for a motion whose quantities are not the model's coordinates
+(the image point of a gyroscope's spin axis, gimbal_precession): "quantities" names the
+columns motion_answer returns (default: the coordinates); "scale": "excursion" measures
+each quantity's error against the motion's largest excursion from its start (the norm over
+the quantities), not against its largest magnitude (at least 1): the drift of a point
+near the origin is the answer, so its size is the scale.
 """
 from __future__ import annotations
 
@@ -39,12 +46,29 @@ def initial_conditions(model) -> dict:
     return out
 
 
+def _declared(model) -> dict:
+    """The motion levels' evaluator options shared by all of them (quantities, scale)."""
+    for d in model.meta.get("levels", []):
+        ev = d["evaluator"]
+        if NAME in d["answers"] and ev.get("kind") == "trajectory" and "quantities" in ev:
+            return {"quantities": list(ev["quantities"]), "scale": ev.get("scale", "magnitude")}
+    return {"quantities": list(model.meta["coordinates"]), "scale": "magnitude"}
+
+
 def quantities(model, opts) -> list[str]:
-    return list(model.meta["coordinates"])
+    return _declared(model)["quantities"]
 
 
 def requested(model, opts) -> list[int]:
-    return list(range(len(model.meta["coordinates"])))
+    return list(range(len(quantities(model, opts))))
+
+
+def _scale(q: np.ndarray, kind: str) -> np.ndarray:
+    """Per quantity (columns of q, times x quantities): the error's scale."""
+    if kind == "excursion":
+        ex = float(np.max(np.sqrt(np.sum((q - q[:1]) ** 2, axis=1))))
+        return np.full(q.shape[1], ex if ex > 0 else np.nan)  # no excursion: no relative error
+    return np.maximum(np.max(np.abs(q), axis=0), 1.0)
 
 
 def times(opts) -> np.ndarray:
@@ -58,9 +82,11 @@ def answer(model, level, P, opts) -> Answer:
     t = times(opts)
     init = {k: v[1] for k, v in mod.INITIAL.items()}  # (unit, default, description)
     init.update(opts.get("initial", {}))
-    N, nc = P.shape[0], len(model.meta["coordinates"])
+    kind = _declared(model)["scale"]
+    N, nc = P.shape[0], len(quantities(model, opts))
     values = np.full((N, nc, t.size), np.nan)
     est = np.full((N, nc), np.inf)
+    scales = np.full((N, nc), np.nan)
     failed = np.full(N, "", object)
     for k in range(N):
         params = dict(zip(model.param_names, map(float, P[k])))
@@ -72,11 +98,13 @@ def answer(model, level, P, opts) -> Answer:
             failed[k] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             continue
         values[k] = q.T
-        scale = np.maximum(np.max(np.abs(q), axis=0), 1.0)
-        est[k] = e / scale
+        scales[k] = _scale(q, kind)
+        est[k] = e / scales[k]
         if not np.all(np.isfinite(q)):
             failed[k] = "the motion could not be computed"
-    return Answer(values, est, failed, {"t": np.broadcast_to(t, (N, t.size))})
+        elif not np.all(np.isfinite(scales[k])):
+            failed[k] = "the motion does not move: no scale for a relative error"
+    return Answer(values, est, failed, {"t": np.broadcast_to(t, (N, t.size)), "scale": scales})
 
 
 def edges(model, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
@@ -85,13 +113,12 @@ def edges(model, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
 
 def error(ans: Answer, ref: Answer) -> np.ndarray:
     with np.errstate(all="ignore"):
-        scale = np.maximum(np.max(np.abs(ref.values), axis=2), 1.0)
-        return np.max(np.abs(ans.values - ref.values), axis=2) / scale
+        return np.max(np.abs(ans.values - ref.values), axis=2) / ref.extra["scale"]
 
 
 def document(model, ans: Answer, k: int, idx) -> dict:
     t = ans.extra["t"][k]
     out = {"horizon": float(t[-1]), "t": [float(x) for x in t]}
-    for j, c in enumerate(model.meta["coordinates"]):
+    for j, c in enumerate(quantities(model, {})):
         out[c] = [float(x) for x in ans.values[k, j]]
     return out

@@ -123,7 +123,7 @@ def test_level_map_of_another_models_unknown_level_exits_2(tmp_path):
 def test_scene_picks_the_cheapest_adequate_theory():
     """Balanced, frictionless, the image point near the origin: elementary is enough at
     1e-3; with the outer ring's imbalance it is not, and the small form (28), which keeps it, is."""
-    rc, out, err = run_cli("scene", "gimbal_precession", "motion", "--tol", "1e-3", "--horizon", "5", "--json")
+    rc, out, err = run_cli("scene", "gimbal_precession", "motion", "--tol", "1e-3", "--t-end", "5", "--json")
     assert rc == 0, err
     d = json.loads(out)
     assert {"model", "question", "level", "tried", "error_bound", "seconds", "t", "x", "y"} <= set(d)

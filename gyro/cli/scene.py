@@ -24,6 +24,7 @@ def register(sub) -> None:
     add_set(f)
     f.add_argument("--modes", metavar="I,J,...", help="frequencies: only these modes (1 = the slowest)")
     f.add_argument("--horizon", metavar="T", help="motion: the time span in s")
+    f.add_argument("--t-end", dest="horizon", metavar="T", help="motion: the same as --horizon")
     add_json(f)
     f.set_defaults(run=run)
 

@@ -107,6 +107,8 @@ class CasadiPrinter(PythonCodePrinter):
     def _print_Pow(self, expr):
         if expr.exp == sp.Rational(1, 2):
             return f"ca.sqrt({self._print(expr.base)})"
+        if expr.exp == -sp.Rational(1, 2):  # Python's printer would write 1/math.sqrt
+            return f"(1/ca.sqrt({self._print(expr.base)}))"
         return super()._print_Pow(expr, rational=False)
 
     def _print_Abs(self, expr):

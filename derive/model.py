@@ -127,6 +127,41 @@ class Variant:
     doc: str = ""
 
 
+@dataclass(frozen=True)
+class Bound:
+    """The a-priori relative error bound of one answered quantity of a level
+    (docs/hierarchy.md): `expression`, in the parameters, emitted and evaluated per set,
+    plus, with `estimate=True`, the evaluator's own per-quantity error estimate (a method's
+    rounding estimate, a formula's derived estimate), evaluated with the answer."""
+
+    expression: object = 0
+    estimate: bool = False
+
+
+@dataclass(frozen=True)
+class Level:
+    """One level of a model's hierarchy (docs/hierarchy.md): a named way to answer
+    questions, a model approximation and the method that evaluates it.
+
+    `neglects` says what the approximation drops; `evaluator` (JSON data) how the runtime
+    evaluates it, {"kind": ..., options}, a kind that the answered questions know
+    (gyro/questions/); `answers` maps each question to a Bound for all its quantities or a
+    list of Bounds, one per quantity in the question's order (None: not answered);
+    `valid` names the edges of validity, name -> expression that is > 0 wherever the bounds
+    hold; `cost` is the measured time per set on one core (s, bench/levels.py), None to
+    take the evaluator's own (a ladder method's COST); `reference` the level its error
+    maps are measured against."""
+
+    name: str
+    neglects: str
+    evaluator: dict
+    answers: dict
+    valid: dict = field(default_factory=dict)
+    cost: float | dict | None = None  # a dict {method: s} for a declaration of several methods
+    reference: str | None = None
+    doc: str = ""
+
+
 @dataclass
 class Model:
     """A mechanical system as data: what the generic pipeline needs to derive and emit it."""
@@ -178,6 +213,9 @@ class Model:
     # error estimate as an expression in the parameters), ...]); the runtime takes, per
     # parameter set and mode, the candidate whose own estimate is smallest
     mode_formulas: list = field(default_factory=list)
+    # the model's hierarchy: Level declarations (docs/hierarchy.md), cheapest to most exact
+    # or in any order (the runtime orders them by cost)
+    levels: list = field(default_factory=list)
 
     @property
     def signal_symbols(self) -> list:

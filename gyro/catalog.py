@@ -24,3 +24,23 @@ def generated_dir() -> Path:
 def available() -> list[str]:
     """The generated models: folders of gyro.generated with a metadata.json."""
     return sorted(p.name for p in generated_dir().iterdir() if (p / "metadata.json").exists())
+
+
+def module_constants(folder, wanted: tuple) -> dict:
+    """module name -> {constant: value} of the top-level constants `wanted` (NAME, RUNG, ...)
+    of every public module in `folder`, read from the sources without importing them:
+    how the methods and the questions are found without a list, and without NumPy."""
+    import ast
+    import pkgutil
+
+    out = {}
+    for m in pkgutil.iter_modules([str(folder)]):
+        if m.name.startswith("_"):
+            continue
+        consts = {}
+        for node in ast.parse((Path(folder) / f"{m.name}.py").read_text()).body:
+            if isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name):
+                if node.targets[0].id in wanted and isinstance(node.value, ast.Constant):
+                    consts[node.targets[0].id] = node.value.value
+        out[m.name] = consts
+    return out

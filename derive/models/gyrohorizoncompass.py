@@ -346,6 +346,22 @@ def quantities():
     }
 
 
+def levels():
+    """The hierarchy of the gyrohorizoncompass (docs/hierarchy.md): its linearised operator
+    about the relative equilibrium (3.1)-(3.2) by the ladder's methods (their estimates are
+    the bounds). The nonlinear equations (1.5)-(1.6) are the motion's level, not yet a
+    level of the selector (gyro.analyses.gyrohorizoncompass has no motion_answer)."""
+    from derive.model import Bound, Level
+
+    return [
+        Level("linear_exact", "nothing of the linearised motion about the exact relative equilibrium (3.1)",
+              {"kind": "spectrum", "methods": ["polyroots", "companion", "default", "reference"], "default": "default"},
+              {"frequencies": Bound(estimate=True), "stability": Bound(estimate=True)},
+              reference="linear_exact:reference",
+              doc="the exact operator about the relative equilibrium, by a method of the ladder"),
+    ]
+
+
 def build():
     from derive.model import Model
 
@@ -360,4 +376,5 @@ def build():
             "the integral E (2.2)-(2.3): its derivative is (1.5).omega2 + (1.6) epsilon'": energy_is_conserved,
         },
         quantities=quantities(),
+        levels=levels(),
     )

@@ -497,6 +497,53 @@ def mode_formulas(F):
     ]
 
 
+def levels(F):
+    """The hierarchy of the torsion gyrocompass (docs/hierarchy.md): what each level
+    neglects, its a-priori relative bound per answered quantity, its edges of validity.
+
+    The paper operator (2.4) neglects terms of relative size eps2 = g/(l omega_p^2) (the
+    linearisation at q = 0, whose largest offset is the rotor's radial sag m g/K_p against
+    l2), beta0 and gamma2 of (2.2) (offsets proportional to u3), and u/Omega (A u, I_i u
+    against H); its bound is their sum (measured: at most 0.21 of it over the spreads of
+    bench/levels.py). The decoupled blocks (eps1 = 0: u = 0 in (2.4), (3.1)) neglect besides
+    the Earth-rate coupling of the blocks: 2 u2/omega for the Coriolis terms (largest at
+    the slowest coupled mode, eps1 = u sqrt(l/g)), H u2/K_gamma and H u2/G against the
+    stiffnesses; twice their sum (measured: at most 0.43 of it); omega1 (zero at u = 0) is
+    not answered. The formulas' bound is their derived estimate (mode_formulas)."""
+    from derive.model import Bound, Level
+
+    sag = m * g / (Kp * sp.Abs(l2))
+    beta0 = H * u3 / (G + H * u2)
+    gamma20 = H * u3 / Kgamma
+    paper = F["eps2"] + sag + sp.Abs(beta0) + sp.Abs(gamma20) + u / F["Omega"]
+    coupling = 2 * (H * u2 / Kgamma + H * u2 / G) + 2 * F["eps1"]
+    n = len(REDUCED)
+    exact = "nothing of the linearised motion about the exact equilibrium (amplitudes, nonlinearity)"
+    return [
+        Level("formulas", "everything (3.2)-(3.28) drop: each formula's small parameter to its order",
+              {"kind": "spectrum", "method": "formulas"}, {"frequencies": Bound(estimate=True)},
+              reference="linear_exact",
+              doc="the paper's approximate formulas, corrected, with their derived estimates"),
+        Level("decoupled", "the Earth-rate coupling of the two blocks (eps1 = 0, (3.1)), and what (2.4) drops",
+              {"kind": "charpoly", "function": "paper_charpoly", "set": {"u": 0.0}},
+              {"frequencies": [None] + [Bound(paper + coupling, estimate=True)] * (n - 1)},
+              valid={"Earth rate below the slowest pendulum frequency (eps1 < 1/4)": sp.Rational(1, 4) - F["eps1"],
+                     "l2 != 0 (the sag's bound)": sp.Abs(l2)},
+              cost=1.6e-5, reference="linear_exact",
+              doc="the blocks J', J'' of (2.4) at u = 0: roots of their characteristic polynomials"),
+        Level("linear_paper", "linearisation at q = 0 (offsets of (2.2)), u3 terms, u^2 terms, A u and I_i u against H",
+              {"kind": "charpoly", "function": "paper_charpoly"}, {"frequencies": Bound(paper, estimate=True)},
+              valid={"l2 != 0 (the sag's bound)": sp.Abs(l2)},
+              cost=2.0e-5, reference="linear_exact",
+              doc="the paper's printed operator (2.4), corrected: roots of its blocks' characteristic polynomials"),
+        Level("linear_exact", exact,
+              {"kind": "spectrum", "methods": ["polyroots", "companion", "default", "reference"], "default": "default"},
+              {"frequencies": Bound(estimate=True), "stability": Bound(estimate=True)},
+              reference="linear_exact:reference",
+              doc="the exact operator about the exact equilibrium, by a method of the ladder (docs/methods.md)"),
+    ]
+
+
 def build():
     """The model as data for the generic pipeline."""
     from derive.model import Model, Variant
@@ -522,4 +569,5 @@ def build():
             doc="the paper's printed operator (2.4): linearised at q = 0, u3 dropped, u^2 "
                 "dropped, A u and I_i u neglected against H")},
         formulas=formulas, formula_docs=docs, mode_formulas=mode_formulas(formulas),
+        levels=levels(formulas),
     )

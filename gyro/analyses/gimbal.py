@@ -644,3 +644,30 @@ def trajectory(motion: Motion, t, method: str = "closed_form"):
         theta, psi, phi = q[:, 1], q[:, 0], q[:, 2]
     return Trajectory(MODEL, model.meta["title"], method, t, theta, psi, phi,
                       motion.integrals0, kind, period)
+
+
+def motion_answer(motion: Motion, t, method: str = "closed_form", rtol: float = RTOL):
+    """The `motion` question's evaluator (gyro/questions/motion.py, docs/hierarchy.md): the
+    coordinates psi, theta, phi at the times t (times, 3) and an estimate of each one's
+    largest absolute error over t (rad).
+
+    Closed form: its rounding grows with the periods run and as 1 - m -> 0 near the
+    separatrix, eps (16 (1 + n) + 4/sqrt(1 - m)) (measured, bench/results/gimbal.json:
+    1.3e-15 over 100 periods, 1.8e-13 over 1e4, 1.1e-8 at 1 - m ~ 1e-18, each below it).
+    An integrator: twice the difference to a second run at rtol/100 (the answer is the finer
+    run), an estimate of the coarser run's global error that bounds the finer one's where
+    the error falls with the tolerance (it does not near a separatrix: docs/gimbal.md)."""
+    t = np.asarray(t, dtype=float)
+    eps = np.finfo(float).eps
+    if method == "closed_form":
+        cf = ClosedForm(motion)
+        psi, phi = cf.psi_phi(t)
+        q = np.stack([psi, cf.theta(t), phi], axis=1)
+        if cf.stationary:
+            return q, np.full(3, 16 * eps * (1 + np.max(np.abs(q))))
+        n = (t[-1] - t[0]) / cf.period if math.isfinite(cf.period) else math.inf
+        est = eps * (16 * (1 + n) + 4 / math.sqrt(max(cf.m1, 1e-300)))
+        return q, np.full(3, est * max(1.0, float(np.max(np.abs(q)))))
+    q1, _ = integrate(motion, t, method, rtol, rtol * 1e-2)
+    q2, _ = integrate(motion, t, method, rtol * 1e-2, rtol * 1e-4)
+    return q2, 2 * np.max(np.abs(q1 - q2), axis=0)

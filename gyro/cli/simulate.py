@@ -9,6 +9,11 @@ rad (at rest), by integrating the emitted (1.5)-(1.6) (default DOP853; `projecte
 steps of DOP853's tableau projected onto E = E(0)); E (2.3) along it. Parameters:
 A B C J L I nu zeta eta lambda (lambda defaults to 1 + chi).
 
+`gyro simulate gimbal_precession --level {full,rigorous,image,small,elementary} --t-end T
+[--points N] [--set NAME=VALUE]... [--json] [--out FILE.png]`: the image point and the gimbal
+angles by one level of the precession hierarchy (docs/precession.md). JSON keys: model,
+level, params, t, x, y, alpha, beta (and H, seconds).
+
 Parameters: the model's (`gyro params gimbal_gyroscope`) and the initial conditions
 theta0 dtheta0 dpsi0 dphi0 (rad, rad/s); psi(0) = phi(0) = 0. Every input is checked before
 anything is computed; bad input exits with 2 and one line naming it.
@@ -23,7 +28,7 @@ from gyro.errors import ParameterError, finite_number
 
 ORDER = 50
 MAX_POINTS = 10**6  # time points: 8 MB a coordinate
-SIMULATED = ("gimbal_gyroscope", "gyrohorizoncompass")
+SIMULATED = ("gimbal_gyroscope", "gyrohorizoncompass", "gimbal_precession")
 
 
 def register(sub) -> None:
@@ -38,6 +43,8 @@ def register(sub) -> None:
                    "Radau, BDF, LSODA, cvodes, idas (gimbal) or cvodes-adams, projected (gyrohorizoncompass)")
     s.add_argument("--perturb", default=None, metavar="D1,D2,D3,D4",
                    help="gyrohorizoncompass: alpha, beta, gamma, epsilon - epsilon0 at t = 0, rad (default 0,0,0,0)")
+    s.add_argument("--level", default=None, metavar="LEVEL",
+                   help="gimbal_precession: full, rigorous, image, small or elementary (required)")
     add_json(s)
     s.add_argument("--out", metavar="FILE.png", help="also plot the coordinates against t into FILE.png")
     s.set_defaults(run=run)
@@ -125,6 +132,29 @@ def _run_ghc(args) -> int:
     return 0
 
 
+def _run_precession(args) -> int:
+    """gimbal_precession: every input checked first (names, numbers, --level, --t-end,
+    --points, --out, the initial angles), then integrated by the level."""
+    from gyro.analyses import precession
+
+    for flag in ("perturb", "method"):
+        if getattr(args, flag) is not None:
+            raise ParameterError(f"--{flag}: not for gimbal_precession (its levels: --level)")
+    if args.level is None:
+        raise ParameterError(f"--level: required for gimbal_precession; one of {', '.join(precession.LEVELS)}")
+    if args.level not in precession.LEVELS:
+        raise ParameterError(f"--level: unknown level {args.level!r}; known: {', '.join(precession.LEVELS)}")
+    values = precession.parameters(parse_sets(args.set))
+    t = _times(args)
+    out = check_png_out(args.out) if args.out is not None else None
+    precession.initial_state(args.level, values)  # the initial angles away from +-90 deg
+    motion = precession.simulate(values, t, args.level)
+    if out is not None:
+        motion.plot(out)
+    print(json.dumps(motion.to_dict(), allow_nan=False) if args.json else motion.table())
+    return 0
+
+
 def run(args) -> int:
     import numpy as np
 
@@ -132,6 +162,10 @@ def run(args) -> int:
 
     if args.model == "gyrohorizoncompass":
         return _run_ghc(args)
+    if args.model == "gimbal_precession":
+        return _run_precession(args)
+    if args.level is not None:
+        raise ParameterError("--level: only for gimbal_precession")
     motion, t, method = parse(args)
     tr = trajectory(motion, t, method)
     if not (np.all(np.isfinite(tr.theta)) and np.all(np.isfinite(tr.psi)) and np.all(np.isfinite(tr.phi))):

@@ -6,11 +6,8 @@ and `solve(model, P, tol) -> gyro.results.Spectrum` over a batch P (sets, parame
 `get(name)` imports one method."""
 from __future__ import annotations
 
-import ast
 import importlib
-import pkgutil
 from functools import lru_cache
-from pathlib import Path
 
 DEFAULT_TOL = 1e-10  # the relative error the default method answers within
 
@@ -18,18 +15,10 @@ DEFAULT_TOL = 1e-10  # the relative error the default method answers within
 @lru_cache(maxsize=None)
 def _declared() -> dict:
     """module -> (NAME, RUNG), from each module's source."""
-    out = {}
-    for m in pkgutil.iter_modules(__path__):
-        if m.name.startswith("_"):
-            continue
-        consts = {}
-        for node in ast.parse((Path(__path__[0]) / f"{m.name}.py").read_text()).body:
-            if isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name):
-                if node.targets[0].id in ("NAME", "RUNG") and isinstance(node.value, ast.Constant):
-                    consts[node.targets[0].id] = node.value.value
-        if "NAME" in consts:
-            out[m.name] = (consts["NAME"], consts.get("RUNG", 99))
-    return out
+    from gyro.catalog import module_constants
+
+    return {m: (c["NAME"], c.get("RUNG", 99)) for m, c in module_constants(__path__[0], ("NAME", "RUNG")).items()
+            if "NAME" in c}
 
 
 def names() -> tuple:

@@ -14,6 +14,9 @@ One module per kind of result; every name is importable from `gyro.results`.
   unknown, failed, each with its reason) and the two tests every analysis reads it through;
 - `sensitivity`: `Sensitivities` (d omega / d p of every frequency and parameter);
 - `tolerance`: `ToleranceStudy` (frequency distributions over manufacturing spreads);
+- `scene`: `Scene` (a question answered at a tolerance by the cheapest adequate level);
+- `precession`: `ImagePointMotion` (the image point by one level of gimbal_precession);
+- `level_map`: `LevelMap` (one level's error against a more exact one over two parameters);
 - `_io`: atomic saving of arrays and figures, shared by all.
 """
 from __future__ import annotations
@@ -21,7 +24,10 @@ from __future__ import annotations
 from gyro.results._io import TMP_TAG, save_figure
 from gyro.results.campbell import FORMULA_BAD, CampbellDiagram
 from gyro.results.gyrohorizoncompass import AngleTrajectory, ConditionMap, EquilibriumStability
+from gyro.results.level_map import LevelMap
+from gyro.results.precession import ImagePointMotion
 from gyro.results.spectrum import ModalResult, Spectrum, Stability, classify, nearest_error
+from gyro.results.scene import Scene
 from gyro.results.sensitivity import Sensitivities
 from gyro.results.stability_map import StabilityMap
 from gyro.results.sweep import FrequencySweep
@@ -31,4 +37,5 @@ from gyro.results.verdict import Verdict
 
 __all__ = ["TMP_TAG", "save_figure", "FORMULA_BAD", "CampbellDiagram", "AngleTrajectory", "ConditionMap",
            "EquilibriumStability", "ModalResult", "Spectrum", "Stability", "classify", "nearest_error",
-           "StabilityMap", "FrequencySweep", "Trajectory", "Verdict", "Sensitivities", "ToleranceStudy"]
+           "StabilityMap", "FrequencySweep", "Trajectory", "Verdict", "Sensitivities", "ToleranceStudy",
+           "Scene", "LevelMap", "ImagePointMotion"]

@@ -1,0 +1,324 @@
+"""The hierarchy measured (docs/hierarchy.md): each level's cost per set, its error against
+the next exact level over the issue's spreads (error maps), the selector's speed goals,
+and the figure of the level the selector picks along a sweep.
+
+`python -m bench.levels` (one core): writes bench/results/levels.json, one error-map
+figure per approximate level (levels_error_<level>.png: measured error against its bound)
+and one scene figure per model (scene_<model>.png). `--quick` for a smaller run.
+
+Spreads (torsion gyrocompass, each about the paper example): spin H, the bearing
+stiffnesses K0, Kp, K_gamma one at a time 0.1x..10x, latitude 0..89 deg, delta_b from 0
+(l1 = l2, l_c kept) to 4x the example's, and a joint random spread of all of them.
+"""
+from __future__ import annotations
+
+import os
+
+for _v in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_v] = "1"  # one core: set before NumPy loads its BLAS
+
+import argparse  # noqa: E402
+import json  # noqa: E402
+import platform  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from gyro import ladder  # noqa: E402
+from gyro import levels as hierarchy  # noqa: E402
+from gyro.analyses.scene import level_error, select  # noqa: E402
+from gyro.models import load  # noqa: E402
+from gyro.questions import frequencies as F  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+RESULTS = ROOT / "bench" / "results"
+TG = load("torsion_gyrocompass")
+APPROXIMATE = ("formulas", "decoupled", "linear_paper", "linear_exact:companion", "linear_exact:polyroots")
+GOALS = {"modes_1e-3_speedup": 100.0, "all_1e-3_speedup": 3.0, "tol_1e-9_slowdown": 1.2,
+         "million_sets_1e-3_s": 60.0, "selector_overhead": 0.10}
+TOLS = (1e-2, 1e-5, 1e-9)
+
+
+def _ix(name):
+    return TG.param_names.index(name)
+
+
+def with_delta_b(P: np.ndarray, factor: np.ndarray) -> np.ndarray:
+    """l1, l2 moved so that l2 - l1 is `factor` times the example's, l_c kept (delta_b ~ factor^2)."""
+    P = P.copy()
+    m, M, l1, l2 = (P[:, _ix(k)] for k in ("m", "M", "l1", "l2"))
+    lc = (m * l2 + M * l1) / (m + M)
+    d = factor * (l2 - l1)
+    P[:, _ix("l1")], P[:, _ix("l2")] = lc - m * d / (m + M), lc + M * d / (m + M)
+    return P
+
+
+def spreads(points: int) -> dict:
+    p0 = TG.vector()
+    s = np.geomspace(0.1, 10.0, points)
+    out = {}
+    for name, label in (("H", "spin"), ("K0", "K0"), ("Kp", "Kp"), ("Kgamma", "K_gamma")):
+        P = np.tile(p0, (points, 1))
+        P[:, _ix(name)] *= s
+        out[f"{label} 0.1x..10x"] = (P, s)
+    P = np.tile(p0, (points, 1))
+    P[:, _ix("phi")] = np.linspace(0.0, 89.0, points)
+    out["latitude 0..89 deg"] = (P, P[:, _ix("phi")])
+    f = np.linspace(0.0, 4.0, points)
+    out["delta_b 0..16x (l2 - l1 0..4x)"] = (with_delta_b(np.tile(p0, (points, 1)), f), f)
+    return out
+
+
+def joint(n: int, seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    P = np.tile(TG.vector(), (n, 1))
+    for name in ("H", "K0", "Kp", "Kgamma"):
+        P[:, _ix(name)] *= np.exp(rng.uniform(np.log(0.1), np.log(10.0), n))
+    P[:, _ix("phi")] = rng.uniform(0.0, 89.0, n)
+    return with_delta_b(P, rng.uniform(0.0, 4.0, n))
+
+
+def per_set(fn, n: int, repeats: int = 3) -> float:
+    """Median seconds per set of fn() over a batch of n sets."""
+    ts = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        ts.append(time.perf_counter() - t0)
+    return float(np.median(ts)) / n
+
+
+# ------------------------------------------------------------------ costs
+
+
+def costs(quick: bool) -> dict:
+    p0 = TG.vector()
+    batch = {"formulas": 200_000, "decoupled": 20_000, "linear_paper": 20_000, "linear_exact:companion": 5000,
+             "linear_exact:default": 20_000, "linear_exact:polyroots": 100, "linear_exact:reference": 2}
+    if quick:
+        batch = {k: max(1, v // 10) for k, v in batch.items()}
+    out = {}
+    for name, n in batch.items():
+        lv = hierarchy.get(TG, name)
+        P = np.tile(p0, (n, 1))
+        F.answer(TG, lv, P[:2], {})  # warm: the compiled code loaded
+        out[name] = {"s_per_set": per_set(lambda: F.answer(TG, lv, P, {}), n, 1 if n < 10 else 3),
+                     "declared": lv.cost, "batch": n}
+    gm = load("gimbal_gyroscope")
+    from gyro.questions import motion
+
+    opts = {"horizon": 1.0}
+    for lv in hierarchy.levels(gm):
+        if quick and lv.name.endswith("Radau"):
+            continue
+        P = gm.vector()[None, :]
+        motion.answer(gm, lv, P, opts)
+        out[f"gimbal_gyroscope {lv.name}"] = {"s_per_set": per_set(lambda: motion.answer(gm, lv, P, opts), 1, 1),
+                                              "declared": lv.cost, "batch": 1, "horizon_s": 1.0}
+    return out
+
+
+# ------------------------------------------------------------------ error maps
+
+
+def error_maps(quick: bool) -> tuple[dict, dict]:
+    points = 13 if quick else 41
+    sp = spreads(points)
+    P_joint = joint(1000 if quick else 20000, seed=7)
+    stats, samples = {}, {}
+    for name in APPROXIMATE:
+        rows, errs, bounds = {}, [], []
+        for label, (P, _) in [*sp.items(), ("joint random", (P_joint, None))]:
+            if name.endswith("polyroots") and label == "joint random":
+                P = P[:300]
+            err, bound = level_error(TG, "frequencies", name, "linear_exact:default", P)
+            ans = F.answer(TG, hierarchy.get(TG, name), P, {})
+            trusted = np.isfinite(bound) & (F.edges(TG, ans, bound, range(bound.shape[1])) == "")[:, None]
+            with np.errstate(all="ignore"):
+                ratio = np.where(trusted, err / bound, np.nan)
+                loose = np.where(trusted & (err > 0), bound / err, np.nan)
+            rows[label] = {
+                "max_error_per_mode": [float(x) for x in np.nanmax(np.where(np.isfinite(err), err, np.nan), axis=0)],
+                "max_error_over_bound": float(np.nanmax(ratio)) if np.isfinite(ratio).any() else None,
+                "median_bound_over_error_per_mode": [None if not np.isfinite(x) else float(x)
+                                                     for x in np.nanmedian(loose, axis=0)],
+                "trusted_fraction": float(trusted.mean()),
+                "beaten": int(np.sum(err[trusted] > bound[trusted] + 1e-10)),
+            }
+            errs.append(np.where(trusted, err, np.nan))
+            bounds.append(np.where(trusted, bound, np.nan))
+        stats[name] = rows
+        samples[name] = (np.concatenate(errs), np.concatenate(bounds))
+    # the exact operator's default method against the 40-digit reference (a few sets per spread)
+    rows = {}
+    for label, (P, _) in sp.items():
+        Pk = P[:: max(1, len(P) // (3 if quick else 5))]
+        err, bound = level_error(TG, "frequencies", "linear_exact:default", "linear_exact:reference", Pk)
+        rows[label] = {"max_error": float(np.nanmax(err)), "max_error_over_bound": float(np.nanmax(err / bound)),
+                       "beaten": int(np.sum(err > bound))}
+    stats["linear_exact:default"] = rows
+    return stats, samples
+
+
+def gimbal_map(quick: bool) -> dict:
+    """The closed form against DOP853 (rtol 1e-10 and 1e-12) over horizons and spins."""
+    gm = load("gimbal_gyroscope")
+    out = []
+    for horizon in ((0.5,) if quick else (0.5, 2.0)):
+        for dphi0 in ((200.0,) if quick else (50.0, 200.0, 800.0)):
+            opts = {"horizon": horizon, "points": 101, "initial": {"dphi0": dphi0, "dtheta0": 3.0}}
+            err, bound = level_error(gm, "motion", "closed_form", "integrated:DOP853", gm.vector()[None, :], opts)
+            _, ref_bound = level_error(gm, "motion", "integrated:DOP853", "closed_form", gm.vector()[None, :], opts)
+            out.append({"horizon": horizon, "dphi0": dphi0, "error": [float(x) for x in err[0]],
+                        "closed_form_bound": [float(x) for x in bound[0]],
+                        "integrator_bound": [float(x) for x in ref_bound[0]],
+                        "held": bool(np.all(err <= bound + ref_bound))})
+    return {"closed_form vs integrated:DOP853": out}
+
+
+# ------------------------------------------------------------------ speed goals
+
+
+def speed(quick: bool) -> dict:
+    n = 2000 if quick else 20000
+    P = np.tile(TG.vector(), (n, 1))
+    for lv in hierarchy.levels(TG):  # warm every compiled path
+        if lv.name != "linear_exact:reference" and not lv.name.endswith("polyroots"):
+            F.answer(TG, lv, P[:2], {})
+    t_exact = per_set(lambda: ladder.spectrum(TG, P, "default"), n)
+    t_modes = per_set(lambda: select(TG, "frequencies", P, 1e-3, {"modes": [1, 2, 4]}), n)
+    t_all = per_set(lambda: select(TG, "frequencies", P, 1e-3), n)
+    t_9 = per_set(lambda: select(TG, "frequencies", P, 1e-9), n)
+    picked = {tol: str(select(TG, "frequencies", P[:1], tol, o).level[0])
+              for tol, o in ((1e-3, {"modes": [1, 2, 4]}), (1e-3, {}), (1e-9, {}))}
+    # the selector's own overhead: select with the formulas alone, against the formulas alone
+    nf = 20 * n
+    Pf = np.tile(TG.vector(), (nf, 1))
+    t_f = per_set(lambda: ladder.spectrum(TG, Pf, "formulas"), nf)
+    t_fsel = per_set(lambda: select(TG, "frequencies", Pf, 1e-3, {"modes": [1, 2, 4]}, among=["formulas"]), nf)
+    # a million sets of the joint spread at 1e-3, all ten frequencies
+    m = 100_000 if quick else 1_000_000
+    Pm = joint(m, seed=11)
+    t0 = time.perf_counter()
+    chunk = 100_000
+    levels_used = {}
+    for s in range(0, m, chunk):
+        sc = select(TG, "frequencies", Pm[s:s + chunk], 1e-3)
+        for name, c in zip(*np.unique(sc.level, return_counts=True)):
+            levels_used[str(name)] = levels_used.get(str(name), 0) + int(c)
+    t_m = time.perf_counter() - t0
+    return {
+        "sets": n, "exact_default_s_per_set": t_exact,
+        "modes_1e-3": {"s_per_set": t_modes, "speedup": t_exact / t_modes, "level": picked[1e-3], "modes": [1, 2, 4]},
+        "all_1e-3": {"s_per_set": t_all, "speedup": t_exact / t_all,
+                     "level": str(select(TG, "frequencies", P[:1], 1e-3).level[0])},
+        "tol_1e-9": {"s_per_set": t_9, "slowdown": t_9 / t_exact, "level": picked[1e-9]},
+        "selector_overhead": {"formulas_s_per_set": t_f, "select_formulas_s_per_set": t_fsel,
+                              "overhead_over_cheapest": (t_fsel - t_f) / t_f},
+        "million_sets_1e-3": {"sets": m, "seconds": t_m * (1_000_000 / m), "measured_s": t_m, "levels": levels_used},
+        "goals": GOALS,
+    }
+
+
+# ------------------------------------------------------------------ figures
+
+
+def error_figures(samples: dict) -> list:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    files = []
+    for name, (err, bound) in samples.items():
+        fig, ax = plt.subplots(figsize=(5.5, 4.5))
+        e, b = err.ravel(), bound.ravel()
+        good = np.isfinite(e) & np.isfinite(b) & (e > 0) & (b > 0)
+        ax.loglog(b[good], e[good], ".", ms=2, alpha=0.4, color="C0", label="a mode of a set")
+        lo, hi = np.nanmin(b[good]), np.nanmax(b[good])
+        ax.loglog([lo, hi], [lo, hi], "k-", lw=1, label="error = bound")
+        ax.loglog([lo, hi], [lo / 100, hi / 100], "k:", lw=1, label="bound 100x loose")
+        ax.set_xlabel("declared bound (relative)")
+        ax.set_ylabel("measured error against linear_exact")
+        ax.set_title(f"torsion_gyrocompass, level {name}\n(spreads and a joint random spread)", fontsize=9)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        path = RESULTS / f"levels_error_{name.replace(':', '_')}.png"
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        files.append(path.name)
+    return files
+
+
+def scene_figure(points: int) -> dict:
+    """Torsion gyrocompass along spin H 0.1x..10x: each level's largest error over the ten
+    modes (lines; its bound dashed), and the level the selector picks for 1e-2, 1e-5, 1e-9."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    P, s = spreads(points)["spin 0.1x..10x"]
+    shown = ("formulas", "linear_paper", "linear_exact:companion", "linear_exact:default")
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7, 6.5), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
+    for i, name in enumerate(shown):
+        against = "linear_exact:reference" if name == "linear_exact:default" else "linear_exact:default"
+        Pk = P[::4] if against.endswith("reference") else P
+        sk = s[::4] if against.endswith("reference") else s
+        err, bound = level_error(TG, "frequencies", name, against, Pk)
+        ax.loglog(sk, np.nanmax(err, axis=1), "-", color=f"C{i}", label=f"{name}: error")
+        ax.loglog(sk, np.max(bound, axis=1), "--", color=f"C{i}", lw=1, label=f"{name}: bound")
+    for tol in TOLS:
+        ax.axhline(tol, color="0.6", lw=0.8)
+        ax.text(s[0], tol * 1.3, f"tol {tol:g}", fontsize=7, color="0.4")
+    ax.set_ylabel("largest relative error over the 10 modes")
+    ax.set_ylim(1e-17, 10)
+    ax.legend(fontsize=7, ncol=2, loc="lower right")
+    ax.set_title("torsion_gyrocompass: which level the selector picks, against spin\n"
+                 "(H 0.1x..10x the paper example; all ten frequencies)", fontsize=9)
+    order = [lv.name for lv in hierarchy.levels(TG) if lv.answers_question("frequencies")]
+    picks = {}
+    for j, tol in enumerate(TOLS):
+        sc = select(TG, "frequencies", P, tol)
+        picks[str(tol)] = [str(x) for x in sc.level]
+        y = [order.index(x) for x in sc.level]
+        ax2.plot(s, y, "o-", ms=3, lw=1, label=f"tol {tol:g}", color=f"C{j + 4}")
+    ax2.set_yticks(range(len(order)), order, fontsize=7)
+    ax2.set_xscale("log")
+    ax2.set_xlabel("spin H / H of the paper example")
+    ax2.legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    fig.savefig(RESULTS / "scene_torsion_gyrocompass.png", dpi=110)
+    plt.close(fig)
+    return {"x": "H / H_example", "values": [float(x) for x in s], "picked": picks}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true")
+    args = ap.parse_args(argv)
+    out = {"machine": {"python": platform.python_version(), "processor": platform.machine(),
+                       "cores": os.cpu_count()}, "quick": args.quick}
+    t0 = time.perf_counter()
+    out["costs"] = costs(args.quick)
+    print(f"costs: {time.perf_counter() - t0:.0f} s", flush=True)
+    stats, samples = error_maps(args.quick)
+    out["error_maps"] = stats
+    out["gimbal_error_map"] = gimbal_map(args.quick)
+    print(f"error maps: {time.perf_counter() - t0:.0f} s", flush=True)
+    out["figures"] = error_figures(samples)
+    out["scene_sweep"] = scene_figure(25 if args.quick else 61)
+    print(f"figures: {time.perf_counter() - t0:.0f} s", flush=True)
+    out["speed"] = speed(args.quick)
+    print(f"speed: {time.perf_counter() - t0:.0f} s", flush=True)
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / "levels.json").write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
+    sp = out["speed"]
+    print(json.dumps({k: sp[k] for k in ("modes_1e-3", "all_1e-3", "tol_1e-9", "selector_overhead",
+                                          "million_sets_1e-3")}, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,272 @@
+"""Precession theory of a gyroscope in a gimbal on a rotating base (Ishlinsky 1959, seed 002):
+the five levels of its hierarchy integrated from one parameter set.
+
+Levels, most exact first (docs/precession.md):
+- `full`: the three-body Lagrange equations (generated `mass_matrix`, `forcing`), started
+  on the precession: alpha'(0), beta'(0) those of (13), phi'(0) = H/A3 - omega_z';
+- `rigorous`: (13) in alpha, beta, H (`rigorous_system`);
+- `image`: (21) in x, y, H (`image_system`): the same motion as `rigorous`;
+- `small`: (28) (`small_system`);
+- `elementary`: (30) (`elementary_system`), H constant.
+Each precession level is emitted as a linear system A r = b in its rates r (the friction
+moments carry the rates), solved at each step.
+Every level is integrated by CasADi's CVODES (Adams, rtol 1e-12) over the generated CasADi
+functions, one integrator per level built once with the parameters as its input.
+The image point and the angles are converted by the generated `image_point` and
+`angles_of_image`. (13) is singular at beta = +-90 deg, and the image point leaves the
+picture plane at alpha = +-90 deg: a motion that reaches either (|cos| < 1e-3) is refused.
+"""
+from __future__ import annotations
+
+import time
+from functools import lru_cache
+
+import numpy as np
+
+from gyro.errors import ParameterError, finite_number
+from gyro.models import load
+
+MODEL = "gimbal_precession"
+LEVELS = ("full", "rigorous", "image", "small", "elementary")  # most exact first
+CLI_NAMES = {"M_motor": "Mmotor"}  # the model file's CLI_NAMES (command line -> model symbol)
+SINGULAR_COS = 1e-3  # |cos beta| (or |cos alpha|) below this: at the singularity (|angle| > 89.94 deg)
+RTOL, ATOL = 1e-12, 1e-14
+MAX_STEPS = 2 * 10**6  # full, between two output times: its nutation at H/J rad/s sets the step
+MAX_STEPS_PRECESSION = 10**4  # between two output times (CVODES counts per output interval); the precession
+# levels take a few hundred for an hour at rtol 1e-12, so more means the singularity at beta = +-90 deg
+
+
+class Singular(ParameterError):
+    """A motion that reaches beta = +-90 deg (where (13) is singular) or alpha = +-90 deg
+    (where the image point leaves the picture plane)."""
+
+
+def cli_name(name: str) -> str:
+    return {v: k for k, v in CLI_NAMES.items()}.get(name, name)
+
+
+def parameters(sets: dict | None = None) -> dict:
+    """Model values (by model symbol) from NAME=VALUE text or numbers by command-line name;
+    each checked (unknown name, not a number, NaN, inf, a non-positive inertia or H, an
+    angle out of range): ParameterError naming it."""
+    model = load(MODEL)
+    known = [cli_name(n) for n in model.param_names]
+    out = {}
+    for key, raw in (sets or {}).items():
+        if key not in known:
+            raise ParameterError(f"unknown parameter {key!r} for {MODEL}; known: {' '.join(known)}")
+        out[CLI_NAMES.get(key, key)] = finite_number(f"parameter {key}", raw)
+    return model.parameters(out)
+
+
+def vector(values: dict) -> np.ndarray:
+    return load(MODEL).vector(values)
+
+
+def named(values: dict) -> dict:
+    """The values by their command-line names."""
+    return {cli_name(k): float(v) for k, v in values.items()}
+
+
+@lru_cache(maxsize=None)
+def _integrator(level: str, n_out: int, rtol_scale: float = 1.0):
+    """A CVODES integrator of one level, parameters as its input p, outputs at n_out times
+    of a grid scaled by its input: y(s) for s in [0, 1] with dy/ds = T f(y)."""
+    import casadi as ca
+
+    cf = load(MODEL).casadi
+    npar = len(load(MODEL).param_names)
+    P = ca.SX.sym("P", npar + 1)  # parameters and the horizon T
+    p, T = P[:npar], P[npar]
+    if level == "full":
+        y = ca.SX.sym("y", 6)
+        rhs = ca.vertcat(y[3:], ca.solve(cf.mass_matrix(p, y[:3]), cf.forcing(p, y[:3], y[3:])))
+    else:
+        y = ca.SX.sym("y", 3)
+        A, b = getattr(cf, f"{level}_system")(p, y[:2], y[2])
+        rhs = ca.solve(A, b)
+    grid = list(np.linspace(0.0, 1.0, n_out))
+    steps = MAX_STEPS if level == "full" else MAX_STEPS_PRECESSION
+    opts = {"abstol": ATOL * rtol_scale, "reltol": RTOL * rtol_scale, "max_num_steps": steps, "linear_multistep_method": "adams",
+            "nonlinear_solver_iteration": "functional", "disable_internal_warnings": True}
+    return ca.integrator(f"F_{level}", "cvodes", {"x": y, "p": P, "ode": T * rhs}, 0.0, grid, opts)
+
+
+def rates(level: str, P, state2, H_now) -> np.ndarray:
+    """The rates of a precession level at one state (angles or image point, and H) from its
+    emitted linear system A r = b."""
+    A, b = getattr(load(MODEL).numpy, f"{level}_system")(P, state2, [H_now])
+    return np.linalg.solve(A, b)
+
+
+def initial_state(level: str, values: dict) -> np.ndarray:
+    nf = load(MODEL).numpy
+    P = vector(values)
+    a0, b0, H0 = values["alpha0"], values["beta0"], values["H"]
+    for name, ang in (("beta0", b0), ("alpha0", a0)):
+        if abs(np.cos(ang)) < SINGULAR_COS:
+            raise Singular(f"parameter {name}: at +-90 deg, where (13) is singular or the image point leaves the plane")
+    if level == "full":
+        ad, bd, _ = rates("rigorous", P, [a0, b0], H0)
+        (pd,) = nf.spin_from_momentum(P, [a0, b0], [ad, bd], [H0])
+        return np.array([a0, b0, 0.0, ad, bd, pd])
+    if level == "rigorous":
+        return np.array([a0, b0, H0])
+    x0, y0 = nf.image_point(P, [a0, b0])
+    return np.array([x0, y0, H0])
+
+
+def simulate(values: dict, t, level: str, rtol_scale: float = 1.0):
+    """The motion of one level at the times t (t[0] = 0): ImagePointMotion. Singular when it
+    reaches beta or alpha = +-90 deg; FloatingPointError when the integrator fails."""
+    import casadi as ca
+
+    from gyro.results import ImagePointMotion
+
+    if level not in LEVELS:
+        raise ParameterError(f"--level: unknown level {level!r} of {MODEL}; known: {', '.join(LEVELS)}")
+    t = np.asarray(t, float)
+    nf = load(MODEL).numpy
+    P = vector(values)
+    y0 = initial_state(level, values)
+    T = float(t[-1])
+    F = _integrator(level, len(t), rtol_scale)
+    c0 = time.process_time()
+    try:
+        Y = np.array(F(x0=y0, p=np.append(P, T))["xf"]).T
+    except RuntimeError as exc:
+        if level != "full" or "MXSTEP" in str(exc).upper():
+            raise Singular(f"{level}: the integration stopped before t = {T:.6g} s (beta or alpha near +-90 deg, "
+                           "where (13) is singular, or the step budget)") from None
+        raise FloatingPointError(f"{level}: CVODES failed before t = {T:.6g} s") from None
+    seconds = time.process_time() - c0
+    Y = np.vstack([y0, Y]) if len(t) != Y.shape[0] else Y
+    if level in ("full", "rigorous"):
+        alpha, beta = Y[:, 0], Y[:, 1]
+        xy = nf.image_point(P, np.stack([alpha, beta], axis=-1))
+        x, y = xy[:, 0], xy[:, 1]
+        if level == "full":
+            H = nf.rotor_momentum(P, Y[:, :3], Y[:, 3:])[:, 0]
+        else:
+            H = Y[:, 2]
+    else:
+        x, y, H = Y[:, 0], Y[:, 1], Y[:, 2]
+        ab = nf.angles_of_image(P, np.stack([x, y], axis=-1))
+        alpha, beta = ab[:, 0], ab[:, 1]
+    if not (np.all(np.isfinite(alpha)) and np.all(np.isfinite(beta)) and np.all(np.isfinite(H))):
+        raise Singular(f"{level}: the motion leaves the domain (beta or alpha reaches +-90 deg)")
+    cb, ca_ = np.cos(beta), np.cos(alpha)
+    near = (np.abs(cb) < SINGULAR_COS) | (np.abs(ca_) < SINGULAR_COS)
+    near[1:] |= (np.sign(cb[1:]) != np.sign(cb[:-1])) | (np.sign(ca_[1:]) != np.sign(ca_[:-1]))  # passed between samples
+    bad = np.flatnonzero(near)
+    if bad.size:
+        k = bad[0]
+        which = "beta" if abs(cb[k]) < SINGULAR_COS or (k > 0 and np.sign(cb[k]) != np.sign(cb[k - 1])) else "alpha"
+        raise Singular(f"{level}: {which} reaches +-90 deg by t = {t[k]:.6g} s, where (13) is singular "
+                       "or the image point leaves the picture plane")
+    return ImagePointMotion(MODEL, level, named(values), t, np.asarray(x, float), np.asarray(y, float),
+                            np.asarray(alpha, float), np.asarray(beta, float), np.asarray(H, float), seconds)
+
+
+def image_error(a, b) -> float:
+    """The error measure of the motion question: max over t of |P_a - P_b| (the image
+    points) relative to the largest displacement of P_b from its start, max |P_b(t) - P_b(0)|.
+    NaN where P_b does not move (no scale)."""
+    d = np.hypot(a.x - b.x, a.y - b.y).max()
+    scale = np.hypot(b.x - b.x[0], b.y - b.y[0]).max()
+    return float(d / scale) if scale > 0 else float("nan")
+
+
+
+
+# ----------------------------------------------------------------------------- the levels' bounds
+#
+# Each level's error against `full`, estimated along the level's own motion (docs/precession.md):
+# - the ring and rotor inertia that every precession level neglects: the full equations'
+#   residual r(t) = Mq q'' - f along the motion (q' from (13), q'' by differences), whose
+#   alpha, beta rows are the neglected inertia moments; a moment r moves the image point at
+#   |r|/H times |d(x, y)/d(alpha, beta)| <= rho^2;
+# - small and elementary: the difference of their rates from (21) along their motion;
+# - the integrator: the difference from the same level at a 100x looser tolerance.
+# Each defect integrated over the horizon is the first-order global error where the flow
+# does not amplify deviations (a turning base and a drift: it does not; friction contracts);
+# the bound is twice the sum, relative to the motion's largest excursion from its start.
+
+SAFETY = 2.0
+LOOSE = 100.0
+
+
+def _scale(m) -> float:
+    return float(np.hypot(m.x - m.x[0], m.y - m.y[0]).max())
+
+
+def _integral(t, f) -> float:
+    return float(np.sum((f[1:] + f[:-1]) * np.diff(t)) / 2)
+
+
+def inertia_defect(values: dict, m) -> np.ndarray:
+    """|r(t)| rho^2 / H along a precession motion m: the image point's rate error from the
+    moments of the rings' and the rotor's transverse inertia that (13) neglects."""
+    nf = load(MODEL).numpy
+    P = vector(values)
+    ab = np.stack([m.alpha, m.beta], axis=-1)
+    A, b = nf.rigorous_system(P, ab, m.H[:, None])
+    r3 = np.linalg.solve(A, b[..., None])[..., 0]
+    ad, bd = r3[:, 0], r3[:, 1]
+    pd = nf.spin_from_momentum(P, ab, np.stack([ad, bd], axis=-1), m.H[:, None])[:, 0]
+    q = np.stack([m.alpha, m.beta, np.zeros_like(m.t)], axis=-1)
+    qd = np.stack([ad, bd, pd], axis=-1)
+    qdd = np.gradient(qd, m.t, axis=0, edge_order=2)
+    Mq, f = nf.mass_matrix(P, q), nf.forcing(P, q, qd)
+    r = np.einsum("nij,nj->ni", Mq, qdd) - f
+    rho2 = 1 + m.x**2 + m.y**2
+    return np.hypot(r[:, 0], r[:, 1]) * rho2 / np.abs(m.H)
+
+
+def rate_defect(values: dict, m, level: str) -> np.ndarray:
+    """|(x', y') of (21) - those of `level`| along the level's motion m."""
+    nf = load(MODEL).numpy
+    P = vector(values)
+    xy, Hs = np.stack([m.x, m.y], axis=-1), m.H[:, None]
+    out = []
+    for lv in ("image", level):
+        A, b = getattr(nf, f"{lv}_system")(P, xy, Hs)
+        out.append(np.linalg.solve(A, b[..., None])[..., 0])
+    d = out[0] - out[1]
+    return np.hypot(d[:, 0], d[:, 1])
+
+
+def bound(values: dict, m) -> float:
+    """The relative error bound of motion m (one level's) against `full` (see above)."""
+    scale = _scale(m)
+    if not scale > 0:
+        return float("inf")
+    loose = simulate(values, m.t, m.level, rtol_scale=LOOSE)
+    integ = float(np.hypot(m.x - loose.x, m.y - loose.y).max())
+    if m.level == "full":
+        return integ / scale
+    defect = _integral(m.t, inertia_defect(values, m))
+    if m.level in ("small", "elementary"):
+        defect += _integral(m.t, rate_defect(values, m, m.level))
+    return (SAFETY * defect + integ) / scale
+
+
+INITIAL: dict = {}  # the initial state is the parameters' (alpha0, beta0, H): no extra conditions
+
+
+class Motion:
+    """The motion question's input (gyro/questions/motion.py): a parameter set by the model's names."""
+
+    def __init__(self, params: dict):
+        self.params = params
+
+
+def motion_answer(motion: Motion, t, method: str, rtol: float = RTOL):
+    """The motion question's evaluator: the image point x, y at the times t (times, 2) and the
+    level's bound as an absolute error of each (its relative bound times the motion's largest
+    excursion, the scale the evaluator declares). Singular (a ValueError) where the motion
+    reaches beta or alpha = +-90 deg."""
+    m = simulate(motion.params, np.asarray(t, float), method)
+    b = bound(motion.params, m)
+    ex = _scale(m)
+    return np.stack([m.x, m.y], axis=-1), np.full(2, b * ex)

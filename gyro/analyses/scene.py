@@ -1,0 +1,107 @@
+"""The selector: a question answered at a tolerance by the cheapest level of the model's
+hierarchy whose bound meets it for every requested quantity (docs/hierarchy.md).
+
+A loop over the declared levels, cheapest first. For each level and the sets still
+unanswered: the a-priori part of its bound (emitted, evaluated per set) and its edges of
+validity decide, before the level is run, whether it can be enough; the level then runs
+on those sets only, and its answer is taken where the whole bound (a-priori part plus
+the evaluator's own estimate), the question's edges (veering, no verdict) and the answer
+itself (computed, finite) hold. The other sets go on up the hierarchy. Nothing here
+knows a model or a question by name; the error of one level against another (an error
+map's entry) is `level_error`.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from gyro import levels as hierarchy
+from gyro import questions
+from gyro.ladder import as_batch
+from gyro.results import Scene
+from gyro.results.scene import (ACCEPTED, APRIORI, BOUND, EDGE, FAILED, NOT_ANSWERED, QUESTION_EDGE,
+                                Trial)
+
+
+def select(model, question: str, P, tol: float, opts: dict | None = None, among: list | None = None) -> Scene:
+    """Answer `question` for every set of P (sets, parameters) within the relative `tol`.
+
+    `opts` are the question's options (`modes` for frequencies, `horizon` for motion);
+    `among` restricts the hierarchy to these level names. Sets that no level can answer
+    keep level '' and the smallest bound offered (`Scene.best`)."""
+    if not (np.isfinite(tol) and 0 < tol < 1):
+        raise ValueError(f"--tol: must be a finite number in (0, 1), got {tol!r}")
+    t0 = time.perf_counter()
+    opts = dict(opts or {})
+    opts.setdefault("tol", tol)
+    q = questions.get(question)
+    P = as_batch(model, P)
+    names = q.quantities(model, opts)
+    idx = q.requested(model, opts)
+    N, nq = P.shape[0], len(names)
+    cands = [lv for lv in hierarchy.levels(model) if lv.answers_question(question)
+             and (among is None or lv.name in among)]
+    if not cands:
+        from gyro.errors import ParameterError
+
+        raise ParameterError(f"question {question!r}: {model.name} declares no level that answers it")
+    level = np.full(N, "", object)
+    bound = np.full((N, len(idx)), np.inf)
+    row = np.full(N, -1)
+    trials, answers = [], {}
+    pending = np.arange(N)
+    for lv in cands:
+        if pending.size == 0:
+            break
+        trial = Trial(lv.name, np.zeros(N, np.int8), np.full(N, np.nan), np.full(N, None, object))
+        trials.append(trial)
+        B = hierarchy.bounds(model, lv, question, P[pending], nq)
+        missing = [names[j] for j in idx if not B.answered[j]]
+        if missing:  # the level does not answer a requested quantity: no set can take it
+            trial.code[pending], trial.missing = NOT_ANSWERED, ", ".join(missing)
+            continue
+        pre = B.apriori[:, idx].max(axis=1) if idx else np.zeros(pending.size)
+        beyond = B.invalid != ""
+        hopeful = ~beyond & (pre <= tol)
+        trial.code[pending[beyond]] = EDGE
+        trial.text[pending[beyond]] = B.invalid[beyond]
+        far = ~beyond & ~hopeful
+        trial.code[pending[far]], trial.value[pending[far]] = APRIORI, pre[far]
+        sub = np.flatnonzero(hopeful)
+        if sub.size == 0:
+            continue
+        ks = pending[sub]
+        ans = q.answer(model, lv, P[ks], opts)
+        total = hierarchy.Bounds(B.apriori[sub], B.estimate, B.invalid[sub], B.answered).total(ans.estimate)
+        edge = q.edges(model, ans, total, idx)
+        worst = total[:, idx].max(axis=1) if idx else np.zeros(sub.size)
+        failed, crossed = ans.failed != "", edge != ""
+        ok = ~failed & ~crossed & (worst <= tol)
+        trial.value[ks] = worst
+        trial.code[ks] = np.where(ok, ACCEPTED, np.where(failed, FAILED, np.where(crossed, QUESTION_EDGE, BOUND)))
+        trial.text[ks[failed]] = ans.failed[failed]
+        trial.text[ks[~failed & crossed]] = edge[~failed & crossed]
+        level[ks[ok]] = lv.name
+        bound[ks[ok]] = total[ok][:, idx]
+        row[ks[ok]] = np.flatnonzero(ok)
+        answers[lv.name] = (q, model, ans, idx)
+        pending = np.setdiff1d(pending, ks[ok], assume_unique=True)
+    return Scene(model.name, question, float(tol), [names[j] for j in idx], level, bound, trials,
+                 time.perf_counter() - t0, answers, row)
+
+
+def level_error(model, question: str, level: str, against: str, P, opts: dict | None = None):
+    """The measured relative error of `level` against the level `against` per set and
+    quantity (an error map's entries), with the bound `level` declares there:
+    (error, bound), each (sets, quantities); NaN error where either level failed."""
+    opts = dict(opts or {})
+    q = questions.get(question)
+    P = as_batch(model, P)
+    a, r = hierarchy.get(model, level), hierarchy.get(model, against)
+    nq = len(q.quantities(model, opts))
+    ans, ref = q.answer(model, a, P, opts), q.answer(model, r, P, opts)
+    err = q.error(ans, ref)
+    err[(ans.failed != "") | (ref.failed != "")] = np.nan
+    B = hierarchy.bounds(model, a, question, P, nq)
+    return err, B.total(ans.estimate)

@@ -1,0 +1,68 @@
+"""The questions a level can answer, one module each, found here without a list
+(docs/hierarchy.md, "Adding a question").
+
+A question module has NAME (the command line's name) and:
+
+- `quantities(model, opts) -> list[str]`: the quantities it answers, in order; a level
+  declares one bound for all of them or one each, in this order;
+- `requested(model, opts) -> list[int]`: the indices the user asked for (`--modes`);
+- `answer(model, level, P, opts) -> Answer`: the level's answer over a batch, by the
+  level's evaluator kind (`level.evaluator["kind"]`); a kind the question does not know
+  is a ValueError naming it;
+- `edges(model, answer, bound, idx) -> array of str`: per set, the question's own edge of
+  validity crossed ('' where none: veering of two modes, a merged root, no verdict);
+- `error(answer, reference) -> (sets, quantities)`: the relative error against another
+  level's answer (error maps);
+- `document(model, answer, k, idx) -> dict`: the question's JSON keys for set k.
+
+`names()` reads NAME from the sources (no NumPy); `get(name)` imports one.
+"""
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+
+
+@dataclass
+class Answer:
+    """One level's answer over a batch: values (sets, quantities), the evaluator's own
+    relative error estimate of each (None where it gives none), a per-set failure reason
+    ('' where it answered) and the question's other per-set data."""
+
+    values: np.ndarray
+    estimate: np.ndarray | None
+    failed: np.ndarray
+    extra: dict = field(default_factory=dict)
+
+    def take(self, rows) -> "Answer":
+        pick = lambda a: None if a is None else a[rows]  # noqa: E731
+        return Answer(self.values[rows], pick(self.estimate), self.failed[rows],
+                      {k: pick(v) for k, v in self.extra.items()})
+
+
+@lru_cache(maxsize=None)
+def _declared() -> dict:
+    """NAME -> module, from each module's source."""
+    from gyro.catalog import module_constants
+
+    return {c["NAME"]: m for m, c in module_constants(__path__[0], ("NAME",)).items() if "NAME" in c}
+
+
+def names() -> tuple:
+    return tuple(sorted(_declared()))
+
+
+def get(name: str):
+    from gyro.errors import ParameterError
+
+    if name not in _declared():
+        raise ParameterError(f"question: unknown {name!r}; known: {', '.join(names())}")
+    return importlib.import_module(f"{__name__}.{_declared()[name]}")
+
+
+def unknown_kind(question: str, level) -> ValueError:
+    return ValueError(f"level {level.name}: the question {question!r} has no evaluator of kind "
+                      f"{level.evaluator.get('kind')!r}")

@@ -1,0 +1,124 @@
+"""`motion`: the motion over a horizon [0, T] (`--horizon`, s) from initial conditions; one
+quantity per coordinate (in the model's order), its relative error the largest deviation
+over the horizon divided by the coordinate's largest magnitude (at least 1 rad) there.
+
+Evaluator kind: `trajectory`, {"analysis": MODULE, "method": NAME, "rtol": R}: the module
+gyro.analyses.MODULE offers INITIAL (name -> (unit, default, description): the initial
+conditions, which `gyro scene` takes with --set), `Motion(params, **initial)` and
+`motion_answer(motion, t, method, rtol) -> (q (times, coordinates), absolute error
+estimate per coordinate)`. An evaluator that refuses a set (the closed form with C0 != 0)
+fails it with its reason, and the selector goes up. JSON keys: `horizon`, `t`, and one
+list per coordinate at the sample times.
+
+Two options of the evaluator, for a motion whose quantities are not the model's coordinates
+(the image point of a gyroscope's spin axis, gimbal_precession): "quantities" names the
+columns motion_answer returns (default: the coordinates); "scale": "excursion" measures
+each quantity's error against the motion's largest excursion from its start (the norm over
+the quantities), not against its largest magnitude (at least 1): the drift of a point
+near the origin is the answer, so its size is the scale.
+"""
+from __future__ import annotations
+
+import importlib
+
+import numpy as np
+
+from gyro.questions import Answer, unknown_kind
+
+NAME = "motion"
+POINTS = 201  # sample times over the horizon
+DEFAULT_HORIZON = 1.0  # s
+
+
+def _analysis(level):
+    return importlib.import_module(f"gyro.analyses.{level.evaluator['analysis']}")
+
+
+def initial_conditions(model) -> dict:
+    """name -> (unit, default, description) of every analysis the model's motion levels
+    name: the question's inputs beside the model's parameters."""
+    from gyro.levels import levels
+
+    out = {}
+    for lv in levels(model):
+        if lv.answers_question(NAME) and lv.evaluator.get("kind") == "trajectory":
+            out.update(_analysis(lv).INITIAL)
+    return out
+
+
+def _declared(model) -> dict:
+    """The motion levels' evaluator options shared by all of them (quantities, scale)."""
+    for d in model.meta.get("levels", []):
+        ev = d["evaluator"]
+        if NAME in d["answers"] and ev.get("kind") == "trajectory" and "quantities" in ev:
+            return {"quantities": list(ev["quantities"]), "scale": ev.get("scale", "magnitude")}
+    return {"quantities": list(model.meta["coordinates"]), "scale": "magnitude"}
+
+
+def quantities(model, opts) -> list[str]:
+    return _declared(model)["quantities"]
+
+
+def requested(model, opts) -> list[int]:
+    return list(range(len(quantities(model, opts))))
+
+
+def _scale(q: np.ndarray, kind: str) -> np.ndarray:
+    """Per quantity (columns of q, times x quantities): the error's scale."""
+    if kind == "excursion":
+        ex = float(np.max(np.sqrt(np.sum((q - q[:1]) ** 2, axis=1))))
+        return np.full(q.shape[1], ex if ex > 0 else np.nan)  # no excursion: no relative error
+    return np.maximum(np.max(np.abs(q), axis=0), 1.0)
+
+
+def times(opts) -> np.ndarray:
+    return np.linspace(0.0, float(opts.get("horizon", DEFAULT_HORIZON)), int(opts.get("points", POINTS)))
+
+
+def answer(model, level, P, opts) -> Answer:
+    if level.evaluator.get("kind") != "trajectory":
+        raise unknown_kind(NAME, level)
+    mod = _analysis(level)
+    t = times(opts)
+    init = {k: v[1] for k, v in mod.INITIAL.items()}  # (unit, default, description)
+    init.update(opts.get("initial", {}))
+    kind = _declared(model)["scale"]
+    N, nc = P.shape[0], len(quantities(model, opts))
+    values = np.full((N, nc, t.size), np.nan)
+    est = np.full((N, nc), np.inf)
+    scales = np.full((N, nc), np.nan)
+    failed = np.full(N, "", object)
+    for k in range(N):
+        params = dict(zip(model.param_names, map(float, P[k])))
+        ic = {n: float(np.broadcast_to(v, (N,))[k]) for n, v in init.items()}
+        try:
+            q, e = mod.motion_answer(mod.Motion(params, **ic), t, level.evaluator["method"],
+                                     level.evaluator.get("rtol", 1e-10))
+        except (ArithmeticError, ValueError, RuntimeError) as exc:  # a refusal or a failure: its reason
+            failed[k] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            continue
+        values[k] = q.T
+        scales[k] = _scale(q, kind)
+        est[k] = e / scales[k]
+        if not np.all(np.isfinite(q)):
+            failed[k] = "the motion could not be computed"
+        elif not np.all(np.isfinite(scales[k])):
+            failed[k] = "the motion does not move: no scale for a relative error"
+    return Answer(values, est, failed, {"t": np.broadcast_to(t, (N, t.size)), "scale": scales})
+
+
+def edges(model, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
+    return np.full(ans.values.shape[0], "", object)
+
+
+def error(ans: Answer, ref: Answer) -> np.ndarray:
+    with np.errstate(all="ignore"):
+        return np.max(np.abs(ans.values - ref.values), axis=2) / ref.extra["scale"]
+
+
+def document(model, ans: Answer, k: int, idx) -> dict:
+    t = ans.extra["t"][k]
+    out = {"horizon": float(t[-1]), "t": [float(x) for x in t]}
+    for j, c in enumerate(quantities(model, {})):
+        out[c] = [float(x) for x in ans.values[k, j]]
+    return out

@@ -23,7 +23,7 @@ TIERS = {
               "test_gyrohorizoncompass"),
     "methods": ("test_ladder", "test_harmonic"),
     "properties": ("test_properties",),
-    "cli": ("test_cli", "test_gimbal_simulate", "test_readme", "test_sweep", "test_wheel", "test_ghc_cli", "test_fuzz", "test_robustness"),
+    "cli": ("test_forced", "test_cli", "test_gimbal_simulate", "test_readme", "test_sweep", "test_wheel", "test_ghc_cli", "test_fuzz", "test_robustness"),
 }
 _TIER_OF = {f: tier for tier, files in TIERS.items() for f in files}
 

@@ -152,3 +152,134 @@ def linear_limit() -> dict:
     the linear level): bench/forced_nonlinear.py's result, read from
     bench/results/forced_linear_limit.json (docs/forced.md)."""
     return json.loads(LIMIT_FILE.read_text())
+
+
+# ----------------------------------------------------------------------------- nonlinear check
+def _rot(axis: str, a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return {"x": np.array([[1, 0, 0], [0, c, -s], [0, s, c]]),
+            "y": np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
+            "z": np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])}[axis]
+
+
+def _spin_free_rate(values: dict, g: dict, gd: dict) -> float:
+    """r2 - gamma3' of (1.6): the rotor's absolute rate on its spin axis without the spin,
+    from the Earth rate (1.3) and the casing rate p (1.5), frames (1.2), (1.6)."""
+    phi = np.radians(values["phi"])
+    u = values["u"] * np.array([0.0, np.cos(phi), np.sin(phi)])
+    S = _rot("z", g["alpha"]) @ _rot("x", g["beta"]) @ _rot("y", g["gamma"])
+    p = (S.T @ (u + gd["alpha"] * np.array([0, 0, 1.0]))
+         + gd["beta"] * np.array([np.cos(g["gamma"]), 0, np.sin(g["gamma"])]) + gd["gamma"] * np.array([0, 1.0, 0]))
+    R = _rot("z", g["gamma1"]) @ _rot("x", g["gamma2"])
+    return float((R.T @ (p + gd["gamma1"] * np.array([0, 0, 1.0])) + gd["gamma2"] * np.array([1.0, 0, 0]))[1])
+
+
+def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12, max_newton: int = 40):
+    """The steady (periodic) response of the full 11-coordinate equations (the emitted
+    `mass_matrix` and `forcing`) to one harmonic f_s = a sin(k omega_c t + phi), the
+    imperfection an explicit function of time (its derivative in gamma3, a torque on the
+    spin that a drive absorbs, left out: the spin keeps its integral C r2 = H).
+
+    gamma3 is cyclic, so the forced equations are periodic in t with T = 2 pi/(k omega_c):
+    the periodic motion is found by shooting over one period (DOP853 at rtol), Newton's
+    correction with the linear operator's monodromy (exact for the linear part) and
+    Broyden's updates for the nonlinear rest.
+    Returns (X_nonlinear, X_linear, info): the first Fourier coefficients of the reduced
+    coordinates over the period (x = Re(X e^{i w t}) + harmonics and offset) and the linear
+    response, info the Newton steps and the final periodicity residual."""
+    from scipy.integrate import solve_ivp
+    from scipy.linalg import expm
+
+    from gyro.equilibrium import equilibrium
+    from gyro.kernels import function
+
+    _check_model(model)
+    s, k, a, phi = harmonic
+    P = model.vector(values)
+    values = model.parameters(values)
+    qe = equilibrium(model, P)
+    W = float(spin_rate(model, P[None], qe[None])[0])
+    w = k * W
+    T = 2 * np.pi / w
+    u = np.zeros(3, complex)
+    u[s - 1] = -1j * a * np.exp(1j * phi)
+    X_lin = harmonic_response(model, P, w, u, qe=qe[None]).X[0]
+    coords, reduced = model.meta["coordinates"], model.meta["reduced"]
+    ri = np.array([coords.index(c) for c in reduced])
+    k3 = coords.index("gamma3")
+    q_ref = np.zeros(len(coords))
+    for name, v in zip(model.meta["equilibrium_coordinates"], qe):
+        q_ref[coords.index(name)] = v
+    mass, force = function(model, "mass_matrix"), function(model, "forcing")
+    zero3 = np.zeros((1, 3))
+
+    def full(z):
+        q = q_ref.copy()
+        q[ri] += z[:len(ri)]
+        qd = np.zeros(len(coords))
+        qd[ri] = z[len(ri):]
+        g, gd = dict(zip(coords, q)), dict(zip(coords, qd))
+        qd[k3] = values["H"] / values["C"] - _spin_free_rate(values, g, gd)
+        return np.concatenate([q, qd])
+
+    def rhs(t, y):
+        q, qd = y[:11], y[11:]
+        F = np.zeros((1, 3))
+        F[0, s - 1] = a * np.sin(w * t + phi)
+        Mq = mass(P[None], q[None])[0][0]
+        f = force(P[None], q[None], qd[None], F, zero3)[0][0]
+        return np.concatenate([qd, np.linalg.solve(Mq, f)])
+
+    def period(z):
+        sol = solve_ivp(rhs, (0.0, T), full(z), method="DOP853", rtol=rtol, atol=1e-30, dense_output=True)
+        if not sol.success:
+            raise RuntimeError(f"integration failed: {sol.message}")
+        yT = sol.y[:, -1]
+        zT = np.concatenate([yT[ri] - q_ref[ri], yT[11 + ri]])
+        return zT, sol
+
+    M, D, K = (x[0] for x in operators(model, P[None], qe[None]))
+    n = len(ri)
+    Minv = np.linalg.inv(M)
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ D]])
+    J = expm(A * T) - np.eye(2 * n)
+    z = np.concatenate([X_lin.real, (1j * w * X_lin).real])
+    scale = np.concatenate([np.abs(X_lin), w * np.abs(X_lin)]) + 1e-300
+    # Newton on the periodicity R(z) = z(T) - z, its Jacobian started from the linear
+    # operator's monodromy and corrected by Broyden's rank-one updates: the near-neutral
+    # azimuth mode (1 - e^{i omega1 T} ~ 3e-5) makes the linear Jacobian's error in its
+    # direction matter, which the updates learn. Periodic to 10 rtol of the state's scale.
+    steps, resid = 0, np.inf
+    zT, last = period(z)
+    R = zT - z
+    for steps in range(1, max_newton + 1):
+        resid = float(np.max(np.abs(R)) / scale.max())
+        if resid <= 10 * rtol:
+            break
+        dz = np.linalg.solve(J, -R)
+        z = z + dz
+        zT, last = period(z)
+        R_new = zT - z
+        J += np.outer(R_new - R - J @ dz, dz) / (dz @ dz)
+        R = R_new
+    else:
+        raise RuntimeError(f"no periodic response within {max_newton} Newton steps (residual {resid:.2g})")
+    sol = last
+    N = 64
+    t = np.arange(N) * T / N
+    x = sol.sol(t)[ri] - q_ref[ri, None]
+    X_nl = 2 / N * (x * np.exp(-1j * w * t)[None, :]).sum(axis=1)
+    return X_nl, X_lin, {"newton_steps": steps, "residual": resid, "frequency": w, "period": T}
+
+
+def linear_error(X_nl: np.ndarray, X_lin: np.ndarray, units: list) -> float:
+    """The relative distance of the nonlinear from the linear amplitudes: per unit group
+    (translations, angles), the largest |X_nl - X_lin| against the group's largest |X_lin|;
+    the worse group."""
+    err = 0.0
+    for unit in set(units):
+        idx = [i for i, u in enumerate(units) if u == unit]
+        ref = np.max(np.abs(X_lin[idx]))
+        if ref > 0:
+            err = max(err, float(np.max(np.abs(X_nl[idx] - X_lin[idx])) / ref))
+    return err

@@ -58,7 +58,7 @@ def input_names(model: Model) -> list[str]:
     return list(model.meta.get("inputs", []))
 
 
-def _require_inputs(model: Model) -> None:
+def require_inputs(model: Model) -> None:
     if "input_matrix" not in model.meta["functions"]:
         raise ParameterError(f"{model.name}: the model has no inputs (no input matrix B); "
                              "declare input signals or given functions (docs/models.md)")
@@ -66,7 +66,7 @@ def _require_inputs(model: Model) -> None:
 
 def input_matrix(model: Model, P: np.ndarray, qe: np.ndarray) -> np.ndarray:
     """B (sets, n_q, n_inputs) at the given equilibria."""
-    _require_inputs(model)
+    require_inputs(model)
     with np.errstate(all="ignore"):
         (B,) = function(model, "input_matrix")(*_state_args(model, "input_matrix", P, qe))
     return np.asarray(B, dtype=float).reshape(P.shape[0], -1, len(input_names(model)))
@@ -139,7 +139,7 @@ def harmonic_response(model: Model, P, omega, u, qe=None, x=None, xname: str = "
     P (sets, n_params); omega (sets,) or a scalar, rad/s, >= 0; u (sets, n_inputs) or
     (n_inputs,), complex input amplitudes in the inputs' units; qe the equilibria when
     known (computed otherwise). `x`, `xname`, `xunit` label a swept axis for the plot."""
-    _require_inputs(model)
+    require_inputs(model)
     P = np.atleast_2d(np.asarray(P, dtype=float))
     if P.ndim != 2 or P.shape[1] != len(model.param_names):
         raise ParameterError(f"params: expected shape (sets, {len(model.param_names)}), got {P.shape}")
@@ -203,7 +203,7 @@ def unbalance_response(model: Model, values: dict, force_x: str, force_y: str, m
     `spin` swept linearly from lo to hi (its own unit). Each spin value is its own
     parameter set, at its own equilibrium."""
     names = input_names(model) if "input_matrix" in model.meta["functions"] else []
-    _require_inputs(model)
+    require_inputs(model)
     for flag, name in (("--force-x", force_x), ("--force-y", force_y)):
         if name not in names:
             raise ParameterError(f"{flag} {name!r}: {model.name} has no such input; inputs: {', '.join(names)}")
@@ -236,4 +236,4 @@ def unbalance_response(model: Model, values: dict, force_x: str, force_y: str, m
 
 
 __all__ = ["harmonic_response", "unbalance_response", "solve_batch", "dynamic_stiffness", "operator_at", "input_matrix",
-           "input_names", "spin_rates", "RESONANCE_RTOL", "EquilibriumError"]
+           "input_names", "require_inputs", "spin_rates", "RESONANCE_RTOL", "EquilibriumError"]

@@ -37,7 +37,8 @@ def _default_spin(model) -> str:
     from gyro.analyses import forced
     from gyro.errors import ParameterError
 
-    rates = [p.name for p in model.params if p.unit == "rad/s" or forced.sets_spin(model, p.name)]
+    declared = [p.name for p in model.params if forced.sets_spin(model, p.name)]
+    rates = declared or [p.name for p in model.params if p.unit == "rad/s"]
     if len(rates) == 1:
         return rates[0]
     raise ParameterError(f"--spin: name the parameter that sets the spin ({model.name} has "
@@ -47,11 +48,12 @@ def _default_spin(model) -> str:
 def run(args) -> int:
     import numpy as np
 
-    from gyro.analyses.harmonic import unbalance_response
+    from gyro.analyses.harmonic import require_inputs, unbalance_response
     from gyro.errors import ParameterError
     from gyro.models import load
 
     model = load(args.model)
+    require_inputs(model)
     values = model.parameters(parse_sets(args.set))
     spin = args.spin or _default_spin(model)
     if spin not in model.param_names:

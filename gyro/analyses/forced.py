@@ -22,34 +22,11 @@ import numpy as np
 
 from gyro import ladder
 from gyro.analyses.harmonic import harmonic_response
+from gyro.analyses.spin import MODELS, sets_spin, spin_rate  # noqa: F401  (sets_spin re-exported)
 from gyro.equilibrium import operators
 from gyro.models import Model, ParameterError
 from gyro.results.harmonic import ForcedResponse, HarmonicResponse
-
-MODELS = ("torsion_gyrocompass",)
 INPUTS = ("F1", "F2", "F3")  # f_1, f_2, f_3 of (1.10)
-
-
-def sets_spin(model: Model, name: str) -> bool:
-    """Whether the parameter `name` sets the spin rate that spin_rate gives (H, here)."""
-    return model.name in MODELS and name == "H"
-
-
-def spin_rate(model: Model, P: np.ndarray, qe: np.ndarray | None = None) -> np.ndarray:
-    """omega_c = gamma3' at the relative equilibrium, (2.3) at rest: H/C less the Earth rate
-    on the spin axis, u cos(phi) + u sin(phi) (beta0 + gamma20) (within u/omega_c = 3e-8
-    of H/C at the example; tests/test_paper_items.py)."""
-    if model.name not in MODELS:
-        raise ParameterError(f"{model.name}: no spin rate of the bearing imperfections (torsion gyrocompass only)")
-    P = np.atleast_2d(P)
-    col = {n: P[:, i] for i, n in enumerate(model.param_names)}
-    W = col["H"] / col["C"]
-    if qe is None:
-        return W
-    eq = model.meta["equilibrium_coordinates"]
-    phi = np.radians(col["phi"])
-    tilt = qe[:, eq.index("beta")] + qe[:, eq.index("gamma2")]
-    return W - col["u"] * np.cos(phi) - col["u"] * np.sin(phi) * tilt
 
 
 def parse_harmonic(text: str) -> tuple[int, int, float, float]:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from gyro.analyses.spin import spin_rates
 from gyro.equilibrium import EquilibriumError, equilibria, tame
 from gyro.kernels import chunks, function
 from gyro.models import Model, ParameterError
@@ -176,23 +177,6 @@ def harmonic_response(model: Model, P, omega, u, qe=None, x=None, xname: str = "
                             u=u, X=X, resonance=resonance, equilibrium=qe,
                             x=omega.copy() if x is None else np.asarray(x, dtype=float),
                             xname=xname or "omega", xunit=xunit or "rad/s")
-
-
-def spin_rates(model: Model, P: np.ndarray, spin: str, qe: np.ndarray | None = None) -> np.ndarray:
-    """The spin rate W (rad/s) of each set, set by the parameter `spin`: the parameter itself
-    when its unit is rad/s; for the torsion gyrocompass's momentum H the rotor's spin rate
-    at the relative equilibrium (gyro.analyses.forced.spin_rate). Anything else is refused."""
-    unit = next((p.unit for p in model.params if p.name == spin), None)
-    if unit is None:
-        raise ParameterError(f"--spin {spin!r}: unknown parameter; known: {' '.join(model.param_names)}")
-    if unit == "rad/s":
-        return P[:, model.param_names.index(spin)].copy()
-    from gyro.analyses import forced
-
-    if forced.sets_spin(model, spin):
-        return forced.spin_rate(model, P, qe)
-    raise ParameterError(f"--spin {spin!r}: its unit is {unit}, not rad/s, and {model.name} "
-                         "declares no spin rate for it")
 
 
 def unbalance_response(model: Model, values: dict, force_x: str, force_y: str, magnitude: float,

@@ -34,10 +34,10 @@ def register(sub) -> None:
 
 
 def _default_spin(model) -> str:
-    from gyro.analyses import forced
+    from gyro.analyses.spin import sets_spin
     from gyro.errors import ParameterError
 
-    declared = [p.name for p in model.params if forced.sets_spin(model, p.name)]
+    declared = [p.name for p in model.params if sets_spin(model, p.name)]
     rates = declared or [p.name for p in model.params if p.unit == "rad/s"]
     if len(rates) == 1:
         return rates[0]

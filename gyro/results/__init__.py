@@ -17,6 +17,8 @@ One module per kind of result; every name is importable from `gyro.results`.
 - `scene`: `Scene` (a question answered at a tolerance by the cheapest adequate level);
 - `precession`: `ImagePointMotion` (the image point by one level of gimbal_precession);
 - `level_map`: `LevelMap` (one level's error against a more exact one over two parameters);
+- `harmonic`: `HarmonicResponse` (steady response to harmonic inputs, a Bode curve, an
+  unbalance response), `ForcedResponse` (the bearing imperfections' harmonics, kept apart);
 - `_io`: atomic saving of arrays and figures, shared by all.
 """
 from __future__ import annotations
@@ -24,6 +26,7 @@ from __future__ import annotations
 from gyro.results._io import TMP_TAG, save_figure
 from gyro.results.campbell import FORMULA_BAD, CampbellDiagram
 from gyro.results.gyrohorizoncompass import AngleTrajectory, ConditionMap, EquilibriumStability
+from gyro.results.harmonic import ForcedResponse, HarmonicResponse
 from gyro.results.level_map import LevelMap
 from gyro.results.precession import ImagePointMotion
 from gyro.results.spectrum import ModalResult, Spectrum, Stability, classify, nearest_error
@@ -38,4 +41,4 @@ from gyro.results.verdict import Verdict
 __all__ = ["TMP_TAG", "save_figure", "FORMULA_BAD", "CampbellDiagram", "AngleTrajectory", "ConditionMap",
            "EquilibriumStability", "ModalResult", "Spectrum", "Stability", "classify", "nearest_error",
            "StabilityMap", "FrequencySweep", "Trajectory", "Verdict", "Sensitivities", "ToleranceStudy",
-           "Scene", "LevelMap", "ImagePointMotion"]
+           "Scene", "LevelMap", "ImagePointMotion", "HarmonicResponse", "ForcedResponse"]

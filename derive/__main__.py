@@ -156,7 +156,11 @@ def main(argv=None) -> int:
                     files = emit.emit(model, fns, pipeline.metadata(deriv), out / model.name)
         except (Unsupported, NotAModel) as exc:
             msg = str(exc) if str(exc).startswith(f"{name}: ") else f"{name}: {exc}"
-            print(f"derive: {msg}", file=sys.stderr)
+            print(f"derive: {msg.splitlines()[0] if msg else msg}", file=sys.stderr)
+            return 2
+        except Exception as exc:  # what no check foresaw: still one line, naming the step
+            step = steps.current or "derivation"
+            print(f"derive: {name}: {step} failed: {type(exc).__name__}: {_first_line(exc)}", file=sys.stderr)
             return 2
         print(f"[{name}] {len(files)} files in {out / model.name}; {steps.total:.1f} s", file=sys.stderr)
     (out / "__init__.py").write_text(emit.environment().get_template("generated_init.py.j2").render())

@@ -112,6 +112,25 @@ class CasadiPrinter(PythonCodePrinter):
     def _print_Abs(self, expr):
         return f"ca.fabs({self._print(expr.args[0])})"
 
+    # non-smooth functions (derive/nonsmooth.py) as SX expressions: sign(0) = 0, and
+    # Heaviside(0) its second argument (1/2, or NaN in a linearisation's jump)
+    def _print_sign(self, expr):
+        return f"ca.sign({self._print(expr.args[0])})"
+
+    def _print_Heaviside(self, expr):
+        x = self._print(expr.args[0])
+        h0 = self._print(expr.args[1]) if len(expr.args) > 1 else "0.5"
+        return f"ca.if_else({x} < 0, 0, ca.if_else({x} > 0, 1, {h0}))"
+
+    def _print_NaN(self, expr):
+        return "float('nan')"
+
+    def _print_Piecewise(self, expr):
+        out = self._print(expr.args[-1].expr) if expr.args[-1].cond == sp.true else "float('nan')"
+        for piece in reversed(expr.args[:-1] if expr.args[-1].cond == sp.true else expr.args):
+            out = f"ca.if_else({self._print(piece.cond)}, {self._print(piece.expr)}, {out})"
+        return out
+
     def _print_Pi(self, expr):
         return _float_literal(sp.pi)
 

@@ -16,9 +16,10 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
+from derive import convert
 from derive import mechanics as mech
-from derive import names
-from derive.model import TIME, Function, Model, Unsupported
+from derive import names, nonsmooth
+from derive.model import TIME, Function, Load, Model, Unsupported
 
 P_SYMBOL = sp.Symbol("p")  # the operator d/dt
 Z_SYMBOL = sp.Symbol("z")  # p^2
@@ -30,12 +31,15 @@ class Steps:
     def __init__(self, out=sys.stderr, prefix=""):
         self.out, self.prefix, self.timings = out, prefix, []
         self.t_start = time.perf_counter()
+        self.current = None  # the step running, for a one-line report of its failure
 
     @contextmanager
     def __call__(self, name: str):
         t0 = time.perf_counter()
         print(f"{self.prefix}{name} ...", file=self.out, flush=True)
+        self.current = name
         yield
+        self.current = None
         dt = time.perf_counter() - t0
         self.timings.append((name, dt))
         print(f"{self.prefix}{name}: {dt:.2f} s", file=self.out, flush=True)
@@ -151,10 +155,11 @@ def _given_symbols(model: Model) -> dict:
     return given
 
 
-def _check_declared(model: Model, L, Q) -> None:
+def _check_declared(model: Model, L, Q, kinks=()) -> None:
     """Every symbol of the Lagrangian and the forces is declared: a parameter, a coordinate
-    or its rate, a momentum, a signal, a given value or constant, or time."""
-    known = set(model.symbols) | set(model.q) | set(model.qd) | set(model.signal_symbols) | {TIME}
+    or its rate, a momentum, a signal, a given value or constant, or time (or a kink of
+    derive/nonsmooth.py)."""
+    known = set(model.symbols) | set(model.q) | set(model.qd) | set(model.signal_symbols) | {TIME} | set(kinks)
     known |= set(model.given_values) | set(model.given_derivatives) | set(model.given_constants)
     known |= {s for s in model.cyclic.values() if isinstance(s, sp.Symbol)}
     free = set(L.free_symbols).union(*[sp.sympify(x).free_symbols for x in (Q or [])])
@@ -179,6 +184,10 @@ def _check_reducible(model: Model, L0, Q0, L_in, Q) -> None:
     if model.nonholonomic:
         raise Unsupported(f"{model.name}: nonholonomic constraints are not supported (the machinery "
                           "has no multipliers): write the system in independent coordinates")
+    if model.holonomic:
+        raise Unsupported(f"{model.name}: holonomic constraints are not derived yet (neither elimination "
+                          "nor multipliers): solve them for the dependent coordinates and write the "
+                          "system in independent coordinates")
     for cname in list(model.cyclic) + list(model.steady):
         if cname not in model.coordinates:
             raise Unsupported(f"{model.name}: {cname!r} is not a coordinate")
@@ -213,6 +222,9 @@ def _check_reducible(model: Model, L0, Q0, L_in, Q) -> None:
 
 def derive(model: Model, steps: Steps | None = None) -> Derivation:
     steps = steps or Steps()
+    model = convert.convert(model)  # dynamicsymbols, assumptions, vectors: the machinery's symbols
+    source, kinks = model, nonsmooth.Kinks()
+    model = _frozen(model, kinks)  # sign, Heaviside, Abs, Max, Min: a symbol per kink
     q, qd, qdd = model.q, model.qd, model.qdd
     L = model.lagrangian
     signals = model.signals
@@ -227,7 +239,8 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
         Q0 = None if Q is None else [sp.sympify(x).subs(zero_inputs) for x in Q]
         L_inputs = L - L0  # the terms with inputs: given functions, input signals
         L_in = sp.sympify(mech.substitute([L_inputs], given)[0] if given else L_inputs)
-        _check_declared(model, L_in + L0, Q)
+        _check_declared(model, L_in + L0, Q, kinks.symbols)
+        nonsmooth.check_lagrangian(sp.sympify(L), kinks, list(qd) + model.signal_symbols, model.name)
         L0 = _check_reducible(model, L0, Q0, L_in, Q)
         time_dependent = TIME in sp.sympify(L).free_symbols or any(
             TIME in sp.sympify(x).free_symbols for x in (Q or []))
@@ -261,6 +274,9 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
     rates = {model.velocity(c): sp.sympify(r) for c, r in model.steady.items()}
     Q0r = None if Q0 is None else [Q0[model.coordinates.index(c)] for c in order]
 
+    reference = {v: rates.get(v, 0) for v in qd} | zero_set | zero_inputs
+    reference |= {s: 0 for s in list(model.given_values) + list(model.given_derivatives)}
+
     with steps("equations of the reference and their symmetric zeros"):
         residual = mech.equilibrium_equations(R, rq, rqd, at=zero_set, rates=rates, Q=Q0r, signals=signals)
         for c in model.symmetric_zero:
@@ -291,6 +307,10 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
         E = reduced_equations(L0, Q0)
         op1 = mech.linearize_equations(E, rq, rqd, rqdd, at=zero_set, rates=rates)
 
+    undefined = None
+    if kinks.kinks:  # where the non-smooth terms leave an entry without a derivative
+        undefined = [nonsmooth.undefined_where(kinks, E, xs, reference, model.name) for xs in (rqdd, rqd, rq)]
+
     with steps("the two routes agree (30 digits, random rational points)"):
         agreement = compare_operators(op1, op2)
         if agreement > 1e-25:
@@ -313,6 +333,8 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
                 Ein = mech.eliminate_cyclic(Ein, q, qd, qdd, cyc_idx, L0, list(model.cyclic.values()), signals)
             Ein = [Ein[names_after.index(c)] for c in order]
             B = mech.input_matrix(Ein, w, rq, rqd, rqdd, at=zero_set, rates=rates)
+            if kinks.kinks:
+                B = kinks.thaw(B, reference) + nonsmooth.undefined_where(kinks, Ein, w, reference, model.name)
             keep = [j for j in range(len(w)) if any(B[i, j] != 0 for i in range(B.rows))]
             deriv.inputs = [w[j] for j in keep]
             deriv.input_matrix = B.extract(list(range(B.rows)), keep) if keep else None
@@ -329,7 +351,42 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
             deriv.variants[vname] = VariantResult(opv, blk, polys, scaled)
 
     deriv.timings = steps.timings
+    if kinks.kinks:  # each kink its function again; NaN where a derivative does not exist
+        _thawed(deriv, kinks, reference, undefined)
+    deriv.model = source
     return deriv
+
+
+def _frozen(model: Model, kinks: nonsmooth.Kinks) -> Model:
+    """The model with each sign(u), H(u) (Abs, Max, Min rewritten in them) a kink symbol."""
+    import dataclasses
+
+    fr = kinks.freeze
+    frozen = dataclasses.replace(
+        model, lagrangian=fr(model.lagrangian), dissipation=fr(model.dissipation),
+        loads=[Load(sp.Matrix(ld.vector).applyfunc(fr), sp.Matrix(ld.velocity).applyfunc(fr), ld.name)
+               for ld in model.loads] if any(sp.Matrix(ld.vector).has(*NONSMOOTH) or sp.Matrix(ld.velocity).has(
+                   *NONSMOOTH) for ld in model.loads) else model.loads,
+        generalized_forces={k: fr(v) for k, v in model.generalized_forces.items()})
+    return frozen if kinks.kinks else model
+
+
+NONSMOOTH = (sp.sign, sp.Heaviside, sp.Abs, sp.Max, sp.Min)
+
+
+def _thawed(d: Derivation, kinks: nonsmooth.Kinks, reference: dict, undefined: list) -> None:
+    """Each kink its function again: in the nonlinear equations as they are, in what is
+    taken at the reference with its argument there; the operator NaN where it does not
+    exist (nonsmooth.undefined_where). B was thawed where it was made."""
+    d.mass_matrix, d.forcing = kinks.thaw(d.mass_matrix), kinks.thaw(d.forcing)
+    d.routhian = kinks.thaw(d.routhian)
+    d.equilibrium_residual = kinks.thaw(d.equilibrium_residual, reference)
+    M, D, K = (kinks.thaw(X, reference) + U for X, U in zip((d.operator.M, d.operator.D, d.operator.K), undefined))
+    d.operator = mech.LinearOperator(M, D, K)
+    for v in d.variants.values():
+        v.operator = v.operator.applyfunc(lambda e: kinks.thaw(e, reference))
+        v.charpoly = [[kinks.thaw(c, reference) for c in block] for block in v.charpoly]
+        v.scaled = kinks.thaw(v.scaled, reference)
 
 
 def functions(d: Derivation) -> list[Function]:

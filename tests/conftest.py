@@ -17,7 +17,8 @@ MODEL = "torsion_gyrocompass"
 # `pytest -m unit` (make test-unit) runs the fast tier alone; `make test` runs them all.
 TIERS = {
     "unit": ("test_mechanics", "test_machinery", "test_architecture", "test_results", "test_model_namespace"),
-    "generated": ("test_generated", "test_textbook", "test_docs_models", "test_derivation", "test_docs_api"),
+    "generated": ("test_generated", "test_textbook", "test_docs_models", "test_derivation", "test_docs_api",
+                  "test_mechanics_style"),
     "paper": ("test_paper", "test_anchors", "test_nonlinear", "test_gimbal", "test_gimbal_closed_form",
               "test_gimbal_section6", "test_gimbal_paper_items", "test_paper_items",
               "test_gyrohorizoncompass"),

@@ -36,7 +36,11 @@ def _is_dynamic(e) -> bool:
 
 
 def _plain(s):
-    return s if not isinstance(s, sp.Symbol) or type(s) is not sp.Symbol or not s.assumptions0 else sp.Symbol(s.name)
+    """The machinery's symbol of that name (no assumptions); s itself when it is one."""
+    if not isinstance(s, sp.Symbol) or type(s) is not sp.Symbol:
+        return s
+    p = sp.Symbol(s.name)
+    return s if p == s else p
 
 
 def _vector_types():
@@ -254,7 +258,7 @@ def _convert(model: Model) -> Model:
     signal_map, extra = _inputs(model, exprs, mapping, known)
     mapping.update(signal_map)
     free = set().union(*[e.free_symbols for e in exprs]) | set(model.q) | set(model.qd) | set(model.qdd)
-    mapping.update({s: _plain(s) for s in free if isinstance(s, sp.Symbol) and _plain(s) is not s})
+    mapping.update({s: _plain(s) for s in free if isinstance(s, sp.Symbol) and _plain(s) != s})
     if not mapping and loads == list(model.loads):
         return model
     # derivatives first (their inner functions are replaced with them), then the functions

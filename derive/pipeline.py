@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from derive import convert
+from derive import constraints, convert
 from derive import mechanics as mech
 from derive import names, nonsmooth
 from derive.model import TIME, Function, Load, Model, Unsupported
@@ -78,6 +78,7 @@ class Derivation:
     variants: dict[str, VariantResult] = field(default_factory=dict)
     functions: list[Function] = field(default_factory=list)
     timings: list = field(default_factory=list)
+    constraints: dict = field(default_factory=dict)  # holonomic: eliminated, or multipliers
 
     @property
     def momenta(self) -> list:
@@ -173,6 +174,13 @@ def _check_declared(model: Model, L, Q, kinks=()) -> None:
             raise Unsupported(f"{model.name}: the steady rate of {cname} uses {', '.join(bad)}, not parameters")
 
 
+def _refuse_nonholonomic(model: Model) -> None:
+    if model.nonholonomic:
+        raise Unsupported(f"{model.name}: nonholonomic constraints are not supported (the machinery "
+                          "has no multipliers for velocity constraints): write the system in independent "
+                          "coordinates")
+
+
 def _check_reducible(model: Model, L0, Q0, L_in, Q) -> None:
     """Routh reduction needs each cyclic coordinate ignorable with a conserved momentum; a
     steady motion needs its turning coordinates ignorable. Anything else is refused. L_in
@@ -181,13 +189,8 @@ def _check_reducible(model: Model, L0, Q0, L_in, Q) -> None:
     (of time, along the motion), and one in its equation would change its momentum.
     Returns the Lagrangian with every such coordinate proved absent set to zero (an
     expression can carry one that cancels only by sin^2 + cos^2 = 1)."""
-    if model.nonholonomic:
-        raise Unsupported(f"{model.name}: nonholonomic constraints are not supported (the machinery "
-                          "has no multipliers): write the system in independent coordinates")
-    if model.holonomic:
-        raise Unsupported(f"{model.name}: holonomic constraints are not derived yet (neither elimination "
-                          "nor multipliers): solve them for the dependent coordinates and write the "
-                          "system in independent coordinates")
+    _refuse_nonholonomic(model)
+
     for cname in list(model.cyclic) + list(model.steady):
         if cname not in model.coordinates:
             raise Unsupported(f"{model.name}: {cname!r} is not a coordinate")
@@ -223,6 +226,14 @@ def _check_reducible(model: Model, L0, Q0, L_in, Q) -> None:
 def derive(model: Model, steps: Steps | None = None) -> Derivation:
     steps = steps or Steps()
     model = convert.convert(model)  # dynamicsymbols, assumptions, vectors: the machinery's symbols
+    eliminated = {}
+    if model.holonomic:
+        with steps("holonomic constraints: dependent coordinates solved for, or multipliers"):
+            found = constraints.solve_dependent(model)
+            if found:
+                model, eliminated = constraints.eliminate(model, *found)
+        if not found:
+            return _with_multipliers(model, steps)
     source, kinks = model, nonsmooth.Kinks()
     model = _frozen(model, kinks)  # sign, Heaviside, Abs, Max, Min: a symbol per kink
     q, qd, qdd = model.q, model.qd, model.qdd
@@ -354,7 +365,24 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
     if kinks.kinks:  # each kink its function again; NaN where a derivative does not exist
         _thawed(deriv, kinks, reference, undefined)
     deriv.model = source
+    deriv.constraints = eliminated
     return deriv
+
+
+def _with_multipliers(model: Model, steps: Steps) -> Derivation:
+    """A model whose holonomic constraints have no unique solution: derive/constraints.py."""
+    with steps("checks: names, what the machinery supports"):
+        names.check_model(model)
+        _refuse_nonholonomic(model)
+        Q = generalized_forces(model)
+        exprs = [sp.sympify(model.lagrangian)] + [sp.sympify(x) for x in (Q or [])]
+        if any(e.has(*NONSMOOTH) for e in exprs):
+            raise Unsupported(f"{model.name}: non-smooth functions together with holonomic constraints "
+                              "that need multipliers")
+        _check_declared(model, exprs[0], Q)
+    d = constraints.multipliers(model, Q, steps)
+    d.timings = steps.timings
+    return d
 
 
 def _frozen(model: Model, kinks: nonsmooth.Kinks) -> Model:
@@ -422,6 +450,8 @@ def metadata(d: Derivation) -> dict:
         "given": [str(s) for s in model.given_values + model.given_derivatives + model.given_constants],
         "route_agreement": d.route_agreement,
     }
+    if d.constraints:
+        meta["constraints"] = d.constraints
     for kind in outputs.kinds():
         meta.update(getattr(kind, "metadata", lambda _: {})(d))
     return meta

@@ -191,3 +191,109 @@ def test_every_broken_model_is_one_line_exit_2(tmp_path, change, match):
     assert rc == 2 and match in last and last.startswith("derive: "), err.getvalue()
     assert "Traceback" not in err.getvalue()
     assert not (tmp_path / "out" / "broken").exists()
+
+
+# --------------------------------------------------------------------------- holonomic constraints
+
+
+def _plain(X, q):
+    """sympy's dynamicsymbols as the machinery's symbols: q, q' -> q_d, q'' -> q_dd, F(t) -> F."""
+    from sympy.core.function import AppliedUndef
+    from sympy.physics.mechanics import dynamicsymbols
+
+    t = dynamicsymbols._t
+    X = sp.Matrix(X)
+    sub = {qi.diff(t, 2): sp.Symbol(f"{qi.func}_dd") for qi in q}
+    sub |= {qi.diff(t): sp.Symbol(f"{qi.func}_d") for qi in q}
+    X = X.subs(sub)
+    X = X.subs({f: sp.Symbol(str(f.func)) for f in X.atoms(AppliedUndef)})
+    return X.subs({s: sp.Symbol(s.name) for s in X.free_symbols})
+
+
+def _A_B(d, at):
+    M, D, K = (X.subs(at) for X in (d.operator.M, d.operator.D, d.operator.K))
+    n = M.rows
+    Mi = M.inv()
+    A = sp.Matrix(sp.BlockMatrix([[sp.zeros(n), sp.eye(n)], [-Mi * K, -Mi * D]]))
+    B = sp.Matrix(sp.BlockMatrix([[sp.zeros(n, d.input_matrix.cols)], [Mi * d.input_matrix.subs(at)]]))
+    return A, B
+
+
+def test_nonminimal_pendulum_carries_a_multiplier_and_linearises_as_sympy_does():
+    """test_nonminimal_pendulum of sympy.physics.mechanics with a force F(t) across: the
+    augmented equations are LagrangesMethod's (M q'' + Phi_q' lambda = f with its lambda),
+    and the operator in the independent q2 at (q1, q2) = (L, 0) gives linearize()'s A and B."""
+    from sympy.physics.mechanics import LagrangesMethod, dynamicsymbols
+
+    module, _, d = _derive("nonminimal_pendulum")
+    L, q, hol, loads, N = module.system()
+    lm = LagrangesMethod(L, q, hol_coneqs=hol, forcelist=loads, frame=N)
+    lm.form_lagranges_equations()
+    # LagrangesMethod's eom, M q'' - f + Phi_q' lambda (its solve_multipliers' lambda), and
+    # the constraint's acceleration row of its mass_matrix_full
+    unknowns = sp.Matrix([sp.Symbol("q1_dd"), sp.Symbol("q2_dd"), sp.Symbol("lam1")])
+    eom = _plain(lm.eom.subs(lm.lam_vec[0], sp.Symbol("lam1")), q)
+    assert sp.simplify(eom - (d.mass_matrix * unknowns - d.forcing)[:2, :]) == sp.zeros(2, 1)
+    assert sp.simplify(_plain(lm.mass_matrix_full[4:, 2:], q) - d.mass_matrix[2:, :]) == sp.zeros(1, 3)
+    assert sp.simplify(_plain(lm.forcing_full[4:, :], q) - d.forcing[2:, :]) == sp.zeros(1, 1)
+    t = dynamicsymbols._t
+    Lsym = sp.Symbol("L")
+    op = {q[0]: Lsym, q[1]: 0, q[0].diff(t): 0, q[1].diff(t): 0, q[0].diff(t, 2): 0, q[1].diff(t, 2): 0}
+    op |= {dynamicsymbols("F"): 0}
+    op.update(lm.solve_multipliers(op_point=op))
+    A, B, _ = lm.linearize([q[1]], [q[1].diff(t)], [q[0]], [q[0].diff(t)], op_point=op, A_and_B=True)
+    A_ours, B_ours = _A_B(d, {sp.Symbol("q1"): Lsym, sp.Symbol("q2"): 0})
+    assert sp.simplify(_plain(A, q) - A_ours) == sp.zeros(2, 2)
+    assert sp.simplify(_plain(B, q) - B_ours) == sp.zeros(2, 1)
+    assert d.constraints["dependent"] == ["q1"] and d.constraints["multipliers"] == ["lam1"]
+    # the constraint force -Phi_q' lambda, at rest hanging: lambda = m g/(2 L), force -m g along q1
+    qc = dict(d.model.quantities["constraint_forces"][1])["Qc"]
+    lam0 = sp.solve((d.mass_matrix * sp.Matrix(sp.symbols("a1 a2 lam1")) - d.forcing).subs(
+        {sp.Symbol("q1"): Lsym, sp.Symbol("q2"): 0, sp.Symbol("q1_d"): 0, sp.Symbol("q2_d"): 0, sp.Symbol("F"): 0}),
+        sp.symbols("a1 a2 lam1"), dict=True)[0]
+    assert sp.simplify(qc.subs(lam0).subs({sp.Symbol("q1"): Lsym, sp.Symbol("q2"): 0})
+                       - sp.Matrix([-sp.Symbol("m") * sp.Symbol("g"), 0])) == sp.zeros(2, 1)
+
+
+def test_disc_on_an_incline_eliminates_theta_and_linearises_as_sympy_does():
+    """test_disc_on_an_incline_plane with a torque tau(t): y = R theta is solved for theta;
+    y'' = 2 g sin(alpha)/3 as sympy's rhs(), and linearize()'s A and B with theta dependent."""
+    from sympy.physics.mechanics import LagrangesMethod, dynamicsymbols
+
+    module, _, d = _derive("disc_incline")
+    L, q, hol, loads, N = module.system()
+    lm = LagrangesMethod(L, q, hol_coneqs=hol, forcelist=loads, frame=N)
+    lm.form_lagranges_equations()
+    assert d.model.coordinates == ["y"] and d.constraints["eliminated"] == {"theta": "y/R"}
+    m, g, alpha, R, tau = sp.symbols("m g alpha R tau")
+    assert sp.simplify(d.forcing[0] / d.mass_matrix[0, 0] - (2 * g * sp.sin(alpha) / 3 + 2 * tau / (3 * m * R))) == 0
+    t = dynamicsymbols._t
+    op = {q[0]: 0, q[1]: 0, q[0].diff(t): 0, q[1].diff(t): 0, q[0].diff(t, 2): 0, q[1].diff(t, 2): 0,
+          dynamicsymbols("tau"): 0}
+    op.update(lm.solve_multipliers(op_point=op))
+    A, B, _ = lm.linearize([q[0]], [q[0].diff(t)], [q[1]], [q[1].diff(t)], op_point=op, A_and_B=True)
+    A_ours, B_ours = _A_B(d, {sp.Symbol("y"): 0})
+    assert sp.simplify(_plain(A, q) - A_ours) == sp.zeros(2, 2)
+    assert sp.simplify(_plain(B, q) - B_ours) == sp.zeros(2, 1)
+
+
+def test_constrained_models_emit_and_compile(tmp_path):
+    """Both constrained models through the emitter: every function in C, NumPy, CasADi and
+    mpmath against the symbolic outputs (the dependent coordinates, the constraint forces)."""
+    from derive import emit
+
+    rng = np.random.default_rng(3)
+    for name in ("nonminimal_pendulum", "disc_incline"):
+        _, model, d = _derive(name)
+        fns = pipeline.functions(d)
+        emit.emit(model, fns, pipeline.metadata(d), tmp_path / name)
+        E = _finish(name, model, d, {f.name: f for f in fns}, tmp_path)
+        for fname, fn in E.functions.items():
+            syms = [s for _, ss in fn.inputs for s in ss]
+            vals = {str(s): rng.uniform(0.5, 1.5) for s in syms}
+            with mpmath.workdps(30):
+                want = [np.array(sp.lambdify(syms, mat, modules="mpmath")(*[mpmath.mpf(vals[str(s)]) for s in syms])
+                                 .tolist(), dtype=float) for _, mat in fn.outputs]
+            for backend in BACKENDS:
+                for o, w in zip(call(E, fname, vals, backend), want):
+                    assert_close(o, w.reshape(o.shape), what=f"{backend} {name}.{fname}")

@@ -209,8 +209,8 @@ def _check_scalars(model: Model) -> None:
     _expression(model.dissipation, "the dissipation function", name)
     for cname, Qc in model.generalized_forces.items():
         _expression(Qc, f"the generalised force on {cname}", name)
-    for k, c in enumerate(list(model.holonomic) + list(model.nonholonomic)):
-        _expression(c, f"constraint {k + 1}", name)
+    for k, c in enumerate(model.holonomic):  # a nonholonomic one is refused as such, whatever it is
+        _expression(c, f"holonomic constraint {k + 1}", name)
 
 
 def _check_expressions(model: Model) -> None:

@@ -178,6 +178,7 @@ BODY = textwrap.dedent('''
      ".Signal('F', 'N', 'force', order=0)])", "differentiated 1 times, beyond its declared order 0"),
     ("extra = dict(nonholonomic=[x_d - x])", "nonholonomic"),
     ("extra = dict(holonomic=[x - 1])", "holonomic"),
+    ("extra = dict(identities={'boom': lambda: [1 / 0]})", "identity: boom failed: ZeroDivisionError"),
 ])
 def test_every_broken_model_is_one_line_exit_2(tmp_path, change, match):
     from derive.__main__ import main

@@ -177,7 +177,7 @@ def multipliers(model: Model, Q, steps):
     rq = [q[i] for i in ind]
     d = Derivation(model=model, mass_matrix=Maug, forcing=faug, routhian=model.lagrangian, rq=rq,
                    rqd=[qd[i] for i in ind], rqdd=[qdd[i] for i in ind], even=q,
-                   equilibrium_residual=residual, operator=op, route_agreement=0.0, order=order,
+                   equilibrium_residual=residual, operator=op, route_agreement=None, order=order,
                    time_dependent=TIME in (Maug.free_symbols | faug.free_symbols))
     w = list(model.input_signal_symbols)
     if w:

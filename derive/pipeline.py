@@ -69,7 +69,7 @@ class Derivation:
     even: list  # reduced coordinates that are unknowns of the reference (not zero by symmetry)
     equilibrium_residual: sp.Matrix  # minus the equations at the reference, function of `even`
     operator: mech.LinearOperator  # exact, at the reference, function of `even`
-    route_agreement: float  # max |route1 - route2| / max |route2| at random points
+    route_agreement: float | None  # max |route1 - route2| / max |route2| at random points (None: one route)
     order: list = field(default_factory=list)  # names of the reduced coordinates
     rates: dict = field(default_factory=dict)  # velocity symbol -> rate on a steady motion
     inputs: list = field(default_factory=list)  # w: columns of B (symbols)

@@ -247,6 +247,7 @@ def test_nonminimal_pendulum_carries_a_multiplier_and_linearises_as_sympy_does()
     assert sp.simplify(_plain(A, q) - A_ours) == sp.zeros(2, 2)
     assert sp.simplify(_plain(B, q) - B_ours) == sp.zeros(2, 1)
     assert d.constraints["dependent"] == ["q1"] and d.constraints["multipliers"] == ["lam1"]
+    assert d.route_agreement is None  # one route: no agreement to claim
     # the constraint force -Phi_q' lambda, at rest hanging: lambda = m g/(2 L), force -m g along q1
     qc = dict(d.model.quantities["constraint_forces"][1])["Qc"]
     lam0 = sp.solve((d.mass_matrix * sp.Matrix(sp.symbols("a1 a2 lam1")) - d.forcing).subs(

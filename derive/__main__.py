@@ -4,10 +4,12 @@ to DIR/<name>/, step by step with the time of each step."""
 from __future__ import annotations
 
 import argparse
+import hashlib
 import importlib
 import importlib.util
 import sys
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 from derive import emit, pipeline
@@ -19,9 +21,58 @@ class NotAModel(ValueError):
     """A file or module that does not define a model; the message is one line."""
 
 
+def _helper_of(name: str, module, folder: Path) -> bool:
+    """A module that `import NAME` resolved from the model's folder (sys.path[0] while the
+    model runs): NAME's top-level part is a file or package of that folder. The machinery
+    (derive) and installed packages are never a model's helpers."""
+    top = name.split(".", 1)[0]
+    where = getattr(module, "__file__", None)
+    if top == "derive" or name.startswith(PRIVATE) or not where:
+        return False
+    where = Path(where).resolve()
+    return where == folder / f"{top}.py" or (folder / top) in where.parents
+
+
+PRIVATE = "_derive_model_"
+_OWN: dict[Path, dict] = {}  # model folder -> the helper modules imported from it
+
+
+@contextmanager
+def namespace(module_or_folder):
+    """Run a model's import, build() and derivation with its own folder first on sys.path
+    and its own helper modules in sys.modules: a `springs.py` beside one model is never
+    the `springs` of another derived in the same call. Modules of that name loaded from
+    elsewhere are set aside meanwhile and put back after."""
+    folder = getattr(module_or_folder, "__derive_folder__", module_or_folder)
+    if not isinstance(folder, Path):  # a model of derive/models/: package-qualified imports
+        yield
+        return
+    own = _OWN.setdefault(folder, {})
+    names = {p.stem for p in folder.glob("*.py")} | {p.name for p in folder.iterdir() if p.is_dir()}
+    aside = {k: v for k, v in sys.modules.items()
+             if k.split(".", 1)[0] in names and own.get(k) is not v and not _helper_of(k, v, folder)
+             and not k.startswith(("derive", PRIVATE))}
+    for k in aside:
+        del sys.modules[k]
+    sys.modules.update(own)
+    present = set(sys.modules)
+    sys.path.insert(0, str(folder))
+    importlib.invalidate_caches()
+    try:
+        yield
+    finally:
+        sys.path.remove(str(folder))
+        for k, v in list(sys.modules.items()):
+            if (k in own or k not in present) and _helper_of(k, v, folder):
+                own[k] = v
+                del sys.modules[k]
+        sys.modules.update(aside)
+
+
 def load_file(path: str | Path):
     """The module of a model file (or of a model folder's __init__.py) anywhere on disk,
-    registered under a private name so that its own imports and the emitter find it."""
+    registered under a private name of its own (its stem and a digest of its path: two
+    folders may hold a model of the same name), imported in its own namespace."""
     path = Path(path).resolve()
     if path.is_dir():
         path = path / "__init__.py"
@@ -30,20 +81,23 @@ def load_file(path: str | Path):
     if path.suffix != ".py":
         raise NotAModel(f"{path}: a model file is a Python file (.py)")
     stem = path.parent.name if path.name == "__init__.py" else path.stem
-    modname = f"_derive_model_{stem}"
+    modname = f"{PRIVATE}{stem}_{hashlib.sha256(str(path).encode()).hexdigest()[:12]}"
     spec = importlib.util.spec_from_file_location(
         modname, path, submodule_search_locations=[str(path.parent)] if path.name == "__init__.py" else None)
     module = importlib.util.module_from_spec(spec)
+    module.__derive_folder__ = path.parent
     sys.modules[modname] = module
-    sys.path.insert(0, str(path.parent))  # a model file may import modules beside it
     try:
-        spec.loader.exec_module(module)
+        with namespace(module):
+            spec.loader.exec_module(module)
     except Exception as exc:  # a model file's own error, reported in one line
         del sys.modules[modname]
-        raise NotAModel(f"{path}: importing it failed: {type(exc).__name__}: {exc}") from exc
-    finally:
-        sys.path.remove(str(path.parent))
+        raise NotAModel(f"{path}: importing it failed: {type(exc).__name__}: {_first_line(exc)}") from exc
     return module
+
+
+def _first_line(exc) -> str:
+    return str(exc).splitlines()[0] if str(exc) else ""
 
 
 def build(module) -> Model:
@@ -52,11 +106,12 @@ def build(module) -> Model:
     if not callable(getattr(module, "build", None)):
         raise NotAModel(f"{where}: not a model: it defines no build() function")
     try:
-        model = module.build()
+        with namespace(module):
+            model = module.build()
     except Unsupported:
         raise
     except Exception as exc:  # the model file's own error, in one line
-        raise NotAModel(f"{where}: build() failed: {type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else ''}") from exc
+        raise NotAModel(f"{where}: build() failed: {type(exc).__name__}: {_first_line(exc)}") from exc
     if not isinstance(model, Model):
         raise NotAModel(f"{where}: not a model: build() returned {type(model).__name__}, not derive.model.Model")
     if sys.modules.get(model.module) is not module:
@@ -93,14 +148,19 @@ def main(argv=None) -> int:
         try:
             with steps("model: energies and parameters"):
                 model = model or build(module)
-            deriv = pipeline.derive(model, steps)
-            with steps("functions to emit"):
-                fns = pipeline.functions(deriv)
-            with steps("emit: CSE, CasADi, NumPy, mpmath, C through the templates"):
-                files = emit.emit(model, fns, pipeline.metadata(deriv), out / model.name)
+            with namespace(module):  # identities and quantities may import helpers late
+                deriv = pipeline.derive(model, steps)
+                with steps("functions to emit"):
+                    fns = pipeline.functions(deriv)
+                with steps("emit: CSE, CasADi, NumPy, mpmath, C through the templates"):
+                    files = emit.emit(model, fns, pipeline.metadata(deriv), out / model.name)
         except (Unsupported, NotAModel) as exc:
             msg = str(exc) if str(exc).startswith(f"{name}: ") else f"{name}: {exc}"
-            print(f"derive: {msg}", file=sys.stderr)
+            print(f"derive: {msg.splitlines()[0] if msg else msg}", file=sys.stderr)
+            return 2
+        except Exception as exc:  # what no check foresaw: still one line, naming the step
+            step = steps.current or "derivation"
+            print(f"derive: {name}: {step} failed: {type(exc).__name__}: {_first_line(exc)}", file=sys.stderr)
             return 2
         print(f"[{name}] {len(files)} files in {out / model.name}; {steps.total:.1f} s", file=sys.stderr)
     (out / "__init__.py").write_text(emit.environment().get_template("generated_init.py.j2").render())

@@ -114,6 +114,25 @@ class CasadiPrinter(PythonCodePrinter):
     def _print_Abs(self, expr):
         return f"ca.fabs({self._print(expr.args[0])})"
 
+    # non-smooth functions (derive/nonsmooth.py) as SX expressions: sign(0) = 0, and
+    # Heaviside(0) its second argument (1/2, or NaN in a linearisation's jump)
+    def _print_sign(self, expr):
+        return f"ca.sign({self._print(expr.args[0])})"
+
+    def _print_Heaviside(self, expr):
+        x = self._print(expr.args[0])
+        h0 = self._print(expr.args[1]) if len(expr.args) > 1 else "0.5"
+        return f"ca.if_else({x} < 0, 0, ca.if_else({x} > 0, 1, {h0}))"
+
+    def _print_NaN(self, expr):
+        return "float('nan')"
+
+    def _print_Piecewise(self, expr):
+        out = self._print(expr.args[-1].expr) if expr.args[-1].cond == sp.true else "float('nan')"
+        for piece in reversed(expr.args[:-1] if expr.args[-1].cond == sp.true else expr.args):
+            out = f"ca.if_else({self._print(piece.cond)}, {self._print(piece.expr)}, {out})"
+        return out
+
     def _print_Pi(self, expr):
         return _float_literal(sp.pi)
 
@@ -192,11 +211,65 @@ def tool_versions() -> dict[str, str]:
 
 
 def model_files(model_file: Path) -> list[Path]:
-    """The files a model is made of: its module file, or every .py of its package folder."""
+    """The files a model is made of: its module file, or every .py of its package folder,
+    and every module beside it that these import (helpers, found by reading the imports)."""
     model_file = Path(model_file).resolve()
     if model_file.name == "__init__.py":
-        return sorted(model_file.parent.rglob("*.py"))
-    return [model_file]
+        own = sorted(model_file.parent.rglob("*.py"))
+    else:
+        own = [model_file]
+    helpers = [f for f in local_imports(own, model_file.parent) if f not in own]
+    return own + sorted(helpers)
+
+
+def _module_file(base: Path, dotted: str) -> Path | None:
+    """base/a/b.py or base/a/b/__init__.py for a dotted name a.b, if it exists."""
+    stem = base.joinpath(*dotted.split("."))
+    for f in (stem.with_suffix(".py"), stem / "__init__.py"):
+        if f.is_file():
+            return f.resolve()
+    return None
+
+
+def local_imports(files, folder: Path) -> list[Path]:
+    """Every file under `folder` that `files` import, directly or through each other: an
+    absolute import resolved from the folder (the model's own sys.path entry) or from the
+    repository (derive.models.<other>), a relative one from the importing file's package.
+    Read from the sources (import statements anywhere, in functions too), so that the set
+    does not depend on which other models were imported first."""
+    import ast
+
+    folder = Path(folder).resolve()
+    todo, seen = [Path(f).resolve() for f in files], set()
+    while todo:
+        f = todo.pop()
+        if f in seen:
+            continue
+        seen.add(f)
+        try:
+            tree = ast.parse(f.read_text())
+        except (OSError, SyntaxError, ValueError):
+            continue
+        names = []
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import):
+                names += [(0, a.name, None) for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                names += [(node.level, node.module or "", a.name) for a in node.names]
+        for level, mod, member in names:
+            if level:
+                base = f.parent
+                for _ in range(level - 1):
+                    base = base.parent
+                bases = [base]
+            else:
+                bases = [folder, ROOT]
+            for base in bases:
+                for dotted in filter(None, [mod, f"{mod}.{member}".strip(".") if member else None]):
+                    hit = _module_file(base, dotted)
+                    if hit is not None and (hit.parent == folder or folder in hit.parents):
+                        todo.append(hit)
+    return sorted(seen)
 
 
 def _shown(path: Path) -> str:
@@ -218,8 +291,9 @@ def machinery_files() -> list[Path]:
 
 def input_hash(model_module_file: Path) -> str:
     """SHA-256 of what makes one model's generated files: the shared machinery and the
-    templates, the model's own file(s) and the versions of the symbolic tools. Other
-    models are not part of it: adding or changing a model rewrites only its own files."""
+    templates, the model's own file(s) with every module it imports from beside itself,
+    and the versions of the symbolic tools. Other models are not part of it (unless one
+    imports another): adding or changing a model rewrites only its own files."""
     h = hashlib.sha256()
     mine = model_files(model_module_file)
     base = Path(model_module_file).resolve().parent
@@ -227,7 +301,7 @@ def input_hash(model_module_file: Path) -> str:
         h.update(_shown(f).encode())
         h.update(b"\0")
         h.update(f.read_bytes())
-    for f in mine:
+    for f in mine:  # the model's file(s), then the helpers it imports from beside itself
         h.update(f.resolve().relative_to(base).as_posix().encode())
         h.update(b"\0")
         h.update(f.read_bytes())

@@ -147,15 +147,22 @@ def partial_time(expr, signals: Sequence = ()):
     return _sp(_partial_time_se(_se(expr), chain(signals)))
 
 
-def kinetic_energy(mass=0, velocity=None, inertia_diag=None, omega=None):
+def kinetic_energy(mass=0, velocity=None, inertia_diag=None, omega=None, inertia=None):
     """Kinetic energy of a rigid body: translation of its mass centre plus rotation about
-    it in principal axes (inertia_diag with omega in those axes)."""
+    it, in principal axes (inertia_diag with omega in those axes) or with the full inertia
+    tensor about the mass centre (`inertia`, a symmetric 3x3 matrix with its products of
+    inertia, in the axes of omega): T_rot = omega' I omega / 2."""
     T = sp.Integer(0)
     if velocity is not None:
         v = sp.Matrix(velocity)
         T += sp.Rational(1, 2) * mass * (v.T * v)[0]
     if inertia_diag is not None:
         T += sp.Rational(1, 2) * sum(J * w**2 for J, w in zip(inertia_diag, omega))
+    if inertia is not None:
+        I, w = sp.Matrix(inertia), sp.Matrix(omega)
+        if I.shape != (3, 3) or I != I.T:
+            raise ValueError("kinetic_energy: the inertia tensor is a symmetric 3x3 matrix")
+        T += sp.Rational(1, 2) * sp.expand((w.T * I * w)[0])
     return T
 
 

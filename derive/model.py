@@ -205,6 +205,13 @@ class Model:
     # constraints between velocities that are not derivatives of coordinate constraints
     # (rolling, knife edges): the machinery has no multipliers for them and refuses them
     nonholonomic: list = field(default_factory=list)
+    # constraints between the coordinates (and time), each an expression that is zero on
+    # every motion: eliminated symbolically where they can be solved for dependent
+    # coordinates, else carried by Lagrange multipliers (derive/constraints.py)
+    holonomic: list = field(default_factory=list)
+    # the inertial ReferenceFrame of sympy.physics.mechanics, for loads written as sympy's
+    # (Point, Vector) or (ReferenceFrame, Vector) (derive/convert.py)
+    frame: object = None
     # model quantities that analyses need, emitted like everything else: name ->
     # (input groups, outputs [(name, Matrix)], doc); groups among params, q, qd, momenta,
     # time, signals, and (name, [symbols]) for inputs of the quantity's own

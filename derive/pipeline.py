@@ -16,9 +16,10 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
+from derive import constraints, convert
 from derive import mechanics as mech
-from derive import names
-from derive.model import TIME, Function, Model, Unsupported
+from derive import names, nonsmooth
+from derive.model import TIME, Function, Load, Model, Unsupported
 
 P_SYMBOL = sp.Symbol("p")  # the operator d/dt
 Z_SYMBOL = sp.Symbol("z")  # p^2
@@ -30,12 +31,15 @@ class Steps:
     def __init__(self, out=sys.stderr, prefix=""):
         self.out, self.prefix, self.timings = out, prefix, []
         self.t_start = time.perf_counter()
+        self.current = None  # the step running, for a one-line report of its failure
 
     @contextmanager
     def __call__(self, name: str):
         t0 = time.perf_counter()
         print(f"{self.prefix}{name} ...", file=self.out, flush=True)
+        self.current = name
         yield
+        self.current = None
         dt = time.perf_counter() - t0
         self.timings.append((name, dt))
         print(f"{self.prefix}{name}: {dt:.2f} s", file=self.out, flush=True)
@@ -65,7 +69,7 @@ class Derivation:
     even: list  # reduced coordinates that are unknowns of the reference (not zero by symmetry)
     equilibrium_residual: sp.Matrix  # minus the equations at the reference, function of `even`
     operator: mech.LinearOperator  # exact, at the reference, function of `even`
-    route_agreement: float  # max |route1 - route2| / max |route2| at random points
+    route_agreement: float | None  # max |route1 - route2| / max |route2| at random points (None: one route)
     order: list = field(default_factory=list)  # names of the reduced coordinates
     rates: dict = field(default_factory=dict)  # velocity symbol -> rate on a steady motion
     inputs: list = field(default_factory=list)  # w: columns of B (symbols)
@@ -74,6 +78,7 @@ class Derivation:
     variants: dict[str, VariantResult] = field(default_factory=dict)
     functions: list[Function] = field(default_factory=list)
     timings: list = field(default_factory=list)
+    constraints: dict = field(default_factory=dict)  # holonomic: eliminated, or multipliers
 
     @property
     def momenta(self) -> list:
@@ -151,10 +156,11 @@ def _given_symbols(model: Model) -> dict:
     return given
 
 
-def _check_declared(model: Model, L, Q) -> None:
+def _check_declared(model: Model, L, Q, kinks=()) -> None:
     """Every symbol of the Lagrangian and the forces is declared: a parameter, a coordinate
-    or its rate, a momentum, a signal, a given value or constant, or time."""
-    known = set(model.symbols) | set(model.q) | set(model.qd) | set(model.signal_symbols) | {TIME}
+    or its rate, a momentum, a signal, a given value or constant, or time (or a kink of
+    derive/nonsmooth.py)."""
+    known = set(model.symbols) | set(model.q) | set(model.qd) | set(model.signal_symbols) | {TIME} | set(kinks)
     known |= set(model.given_values) | set(model.given_derivatives) | set(model.given_constants)
     known |= {s for s in model.cyclic.values() if isinstance(s, sp.Symbol)}
     free = set(L.free_symbols).union(*[sp.sympify(x).free_symbols for x in (Q or [])])
@@ -168,6 +174,13 @@ def _check_declared(model: Model, L, Q) -> None:
             raise Unsupported(f"{model.name}: the steady rate of {cname} uses {', '.join(bad)}, not parameters")
 
 
+def _refuse_nonholonomic(model: Model) -> None:
+    if model.nonholonomic:
+        raise Unsupported(f"{model.name}: nonholonomic constraints are not supported (the machinery "
+                          "has no multipliers for velocity constraints): write the system in independent "
+                          "coordinates")
+
+
 def _check_reducible(model: Model, L0, Q0, L_in, Q) -> None:
     """Routh reduction needs each cyclic coordinate ignorable with a conserved momentum; a
     steady motion needs its turning coordinates ignorable. Anything else is refused. L_in
@@ -176,9 +189,8 @@ def _check_reducible(model: Model, L0, Q0, L_in, Q) -> None:
     (of time, along the motion), and one in its equation would change its momentum.
     Returns the Lagrangian with every such coordinate proved absent set to zero (an
     expression can carry one that cancels only by sin^2 + cos^2 = 1)."""
-    if model.nonholonomic:
-        raise Unsupported(f"{model.name}: nonholonomic constraints are not supported (the machinery "
-                          "has no multipliers): write the system in independent coordinates")
+    _refuse_nonholonomic(model)
+
     for cname in list(model.cyclic) + list(model.steady):
         if cname not in model.coordinates:
             raise Unsupported(f"{model.name}: {cname!r} is not a coordinate")
@@ -213,6 +225,17 @@ def _check_reducible(model: Model, L0, Q0, L_in, Q) -> None:
 
 def derive(model: Model, steps: Steps | None = None) -> Derivation:
     steps = steps or Steps()
+    model = convert.convert(model)  # dynamicsymbols, assumptions, vectors: the machinery's symbols
+    eliminated = {}
+    if model.holonomic:
+        with steps("holonomic constraints: dependent coordinates solved for, or multipliers"):
+            found = constraints.solve_dependent(model)
+            if found:
+                model, eliminated = constraints.eliminate(model, *found)
+        if not found:
+            return _with_multipliers(model, steps)
+    source, kinks = model, nonsmooth.Kinks()
+    model = _frozen(model, kinks)  # sign, Heaviside, Abs, Max, Min: a symbol per kink
     q, qd, qdd = model.q, model.qd, model.qdd
     L = model.lagrangian
     signals = model.signals
@@ -227,7 +250,8 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
         Q0 = None if Q is None else [sp.sympify(x).subs(zero_inputs) for x in Q]
         L_inputs = L - L0  # the terms with inputs: given functions, input signals
         L_in = sp.sympify(mech.substitute([L_inputs], given)[0] if given else L_inputs)
-        _check_declared(model, L_in + L0, Q)
+        _check_declared(model, L_in + L0, Q, kinks.symbols)
+        nonsmooth.check_lagrangian(sp.sympify(L), kinks, list(qd) + model.signal_symbols, model.name)
         L0 = _check_reducible(model, L0, Q0, L_in, Q)
         time_dependent = TIME in sp.sympify(L).free_symbols or any(
             TIME in sp.sympify(x).free_symbols for x in (Q or []))
@@ -261,6 +285,9 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
     rates = {model.velocity(c): sp.sympify(r) for c, r in model.steady.items()}
     Q0r = None if Q0 is None else [Q0[model.coordinates.index(c)] for c in order]
 
+    reference = {v: rates.get(v, 0) for v in qd} | zero_set | zero_inputs
+    reference |= {s: 0 for s in list(model.given_values) + list(model.given_derivatives)}
+
     with steps("equations of the reference and their symmetric zeros"):
         residual = mech.equilibrium_equations(R, rq, rqd, at=zero_set, rates=rates, Q=Q0r, signals=signals)
         for c in model.symmetric_zero:
@@ -291,6 +318,10 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
         E = reduced_equations(L0, Q0)
         op1 = mech.linearize_equations(E, rq, rqd, rqdd, at=zero_set, rates=rates)
 
+    undefined = None
+    if kinks.kinks:  # where the non-smooth terms leave an entry without a derivative
+        undefined = [nonsmooth.undefined_where(kinks, E, xs, reference, model.name) for xs in (rqdd, rqd, rq)]
+
     with steps("the two routes agree (30 digits, random rational points)"):
         agreement = compare_operators(op1, op2)
         if agreement > 1e-25:
@@ -313,6 +344,8 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
                 Ein = mech.eliminate_cyclic(Ein, q, qd, qdd, cyc_idx, L0, list(model.cyclic.values()), signals)
             Ein = [Ein[names_after.index(c)] for c in order]
             B = mech.input_matrix(Ein, w, rq, rqd, rqdd, at=zero_set, rates=rates)
+            if kinks.kinks:
+                B = kinks.thaw(B, reference) + nonsmooth.undefined_where(kinks, Ein, w, reference, model.name)
             keep = [j for j in range(len(w)) if any(B[i, j] != 0 for i in range(B.rows))]
             deriv.inputs = [w[j] for j in keep]
             deriv.input_matrix = B.extract(list(range(B.rows)), keep) if keep else None
@@ -329,7 +362,59 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
             deriv.variants[vname] = VariantResult(opv, blk, polys, scaled)
 
     deriv.timings = steps.timings
+    if kinks.kinks:  # each kink its function again; NaN where a derivative does not exist
+        _thawed(deriv, kinks, reference, undefined)
+    deriv.model = source
+    deriv.constraints = eliminated
     return deriv
+
+
+def _with_multipliers(model: Model, steps: Steps) -> Derivation:
+    """A model whose holonomic constraints have no unique solution: derive/constraints.py."""
+    with steps("checks: names, what the machinery supports"):
+        names.check_model(model)
+        _refuse_nonholonomic(model)
+        Q = generalized_forces(model)
+        exprs = [sp.sympify(model.lagrangian)] + [sp.sympify(x) for x in (Q or [])]
+        if any(e.has(*NONSMOOTH) for e in exprs):
+            raise Unsupported(f"{model.name}: non-smooth functions together with holonomic constraints "
+                              "that need multipliers")
+        _check_declared(model, exprs[0], Q)
+    d = constraints.multipliers(model, Q, steps)
+    d.timings = steps.timings
+    return d
+
+
+def _frozen(model: Model, kinks: nonsmooth.Kinks) -> Model:
+    """The model with each sign(u), H(u) (Abs, Max, Min rewritten in them) a kink symbol."""
+    import dataclasses
+
+    fr = kinks.freeze
+    frozen = dataclasses.replace(
+        model, lagrangian=fr(model.lagrangian), dissipation=fr(model.dissipation),
+        loads=[Load(sp.Matrix(ld.vector).applyfunc(fr), sp.Matrix(ld.velocity).applyfunc(fr), ld.name)
+               for ld in model.loads] if any(sp.Matrix(ld.vector).has(*NONSMOOTH) or sp.Matrix(ld.velocity).has(
+                   *NONSMOOTH) for ld in model.loads) else model.loads,
+        generalized_forces={k: fr(v) for k, v in model.generalized_forces.items()})
+    return frozen if kinks.kinks else model
+
+
+NONSMOOTH = (sp.sign, sp.Heaviside, sp.Abs, sp.Max, sp.Min)
+
+
+def _thawed(d: Derivation, kinks: nonsmooth.Kinks, reference: dict, undefined: list) -> None:
+    """Each kink its function again: in the nonlinear equations as they are, in what is
+    taken at the reference with its argument there; the operator NaN where it does not
+    exist (nonsmooth.undefined_where). B was thawed where it was made."""
+    d.mass_matrix, d.forcing = kinks.thaw(d.mass_matrix), kinks.thaw(d.forcing)
+    d.routhian = kinks.thaw(d.routhian)
+    d.equilibrium_residual = kinks.thaw(d.equilibrium_residual, reference)
+    M, D, K = (kinks.thaw(X, reference) + U for X, U in zip((d.operator.M, d.operator.D, d.operator.K), undefined))
+    d.operator = mech.LinearOperator(M, D, K)
+    for v in d.variants.values():
+        v.operator = v.operator.applyfunc(lambda e: kinks.thaw(e, reference))
+        v.charpoly = [[kinks.thaw(c, reference) for c in block] for block in v.charpoly]
+        v.scaled = kinks.thaw(v.scaled, reference)
 
 
 def functions(d: Derivation) -> list[Function]:
@@ -365,6 +450,8 @@ def metadata(d: Derivation) -> dict:
         "given": [str(s) for s in model.given_values + model.given_derivatives + model.given_constants],
         "route_agreement": d.route_agreement,
     }
+    if d.constraints:
+        meta["constraints"] = d.constraints
     for kind in outputs.kinds():
         meta.update(getattr(kind, "metadata", lambda _: {})(d))
     return meta

@@ -16,8 +16,9 @@ MODEL = "torsion_gyrocompass"
 # Tiers (docs/architecture.md): each test file belongs to one, marked by its name, so that
 # `pytest -m unit` (make test-unit) runs the fast tier alone; `make test` runs them all.
 TIERS = {
-    "unit": ("test_mechanics", "test_machinery", "test_architecture", "test_results"),
-    "generated": ("test_generated", "test_textbook", "test_docs_models", "test_derivation", "test_docs_api"),
+    "unit": ("test_mechanics", "test_machinery", "test_architecture", "test_results", "test_model_namespace"),
+    "generated": ("test_generated", "test_textbook", "test_docs_models", "test_derivation", "test_docs_api",
+                  "test_mechanics_style"),
     "paper": ("test_paper", "test_anchors", "test_nonlinear", "test_gimbal", "test_gimbal_closed_form",
               "test_gimbal_section6", "test_gimbal_paper_items", "test_paper_items",
               "test_gyrohorizoncompass", "test_verdict", "test_ghc_paper_items", "test_precession"),

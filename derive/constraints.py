@@ -1,0 +1,199 @@
+"""Holonomic constraints phi(q, t) = 0 (the model's `holonomic` field).
+
+Where the constraints can be solved for dependent coordinates with one solution (a
+rolling disc's y - R theta = 0: theta = y/R), they are eliminated symbolically: the
+dependent coordinates and their rates are substituted into the Lagrangian, the
+dissipation and the loads, a generalised force on a dependent coordinate is carried to
+the independent ones by virtual work (Q_i += Q_dep d q_dep / d q_i), and the model goes
+on in its independent coordinates. The values of the dependent coordinates and their
+rates are emitted as the quantity `dependent_coordinates`.
+
+Otherwise (a pendulum in Cartesian coordinates, x^2 + y^2 - L^2 = 0: two branches) the
+equations carry Lagrange multipliers lambda, in sympy's convention
+
+    Mq qdd + Phi_q' lambda = f,    Phi_q qdd = -gamma   (gamma = phi'' at qdd = 0),
+
+emitted as one mass-matrix system of n + m unknowns (qdd, lambda): `mass_matrix` is
+[[Mq, Phi_q'], [Phi_q, 0]] and `forcing` [f; -gamma]. The constraint forces on the
+coordinates, -Phi_q' lambda, are the quantity `constraint_forces`, the constraints and
+their Jacobian the quantity `constraints`. The linearisation about rest at q0 (qe, all
+coordinates, on the constraint) is that of the constrained system in its independent
+coordinates (`reduced`, default the first n - m), as sympy's linearize gives it:
+dq = C dq_ind with C = [I; -Phi_dep^-1 Phi_ind], lambda0 from the dependent rows at rest
+(Phi_dep' lambda0 = f_dep), and
+
+    M = C' Mq C,  D = C' (dE/dqd) C,  K = C' (dE/dq + sum_j lambda0_j d2 phi_j/dq2) C,
+    B = C' B_q,
+
+E = Mq qdd - f. What is refused: constraints on rates (nonholonomic), explicit time or
+signals in a constraint that must be carried by multipliers, cyclic or steady
+coordinates, given functions or variants together with multipliers.
+"""
+from __future__ import annotations
+
+import dataclasses
+from itertools import combinations
+
+import sympy as sp
+
+from derive import mechanics as mech
+from derive.model import TIME, Load, Model, Unsupported
+
+
+def _constraints(model: Model) -> list:
+    phis = [sp.sympify(c) for c in model.holonomic]
+    rates = set(model.qd) | set(model.qdd)
+    for k, c in enumerate(phis):
+        if c.free_symbols & rates:
+            raise Unsupported(f"{model.name}: holonomic constraint {k + 1} ({c}) has rates: a constraint on "
+                              "velocities is nonholonomic (give a holonomic one as phi(q, t))")
+        if not c.free_symbols & set(model.q):
+            raise Unsupported(f"{model.name}: holonomic constraint {k + 1} ({c}) has no coordinate")
+    if len(phis) >= len(model.q):
+        raise Unsupported(f"{model.name}: {len(phis)} holonomic constraints on {len(model.q)} coordinates "
+                          "leave no independent coordinate")
+    return phis
+
+
+def solve_dependent(model: Model):
+    """(indices of the dependent coordinates, their solution) when the constraints have one
+    solution for some m coordinates (the last ones tried first), else None."""
+    phis = _constraints(model)
+    q, m = list(model.q), len(phis)
+    for deps in combinations(reversed(range(len(q))), m):
+        dq = [q[i] for i in sorted(deps)]
+        if sp.Matrix(phis).jacobian(dq).det() == 0:
+            continue
+        try:
+            sols = sp.solve(phis, dq, dict=True)
+        except (NotImplementedError, ValueError):
+            continue
+        if len(sols) == 1 and all(d in sols[0] for d in dq) and not any(
+                sols[0][d].has(*dq) for d in dq):
+            return sorted(deps), {d: sols[0][d] for d in dq}
+    return None
+
+
+def eliminate(model: Model, deps: list, sol: dict) -> tuple[Model, dict]:
+    """The model in its independent coordinates, and what was eliminated (for metadata)."""
+    keep = [i for i in range(len(model.q)) if i not in deps]
+    names = [model.coordinates[i] for i in deps]
+    for field_name in ("cyclic", "steady"):
+        bad = sorted(set(getattr(model, field_name)) & set(names))
+        if bad:
+            raise Unsupported(f"{model.name}: {bad} ({field_name}) is eliminated by a holonomic constraint")
+    q = [model.q[i] for i in keep]
+    qd = [model.qd[i] for i in keep]
+    rates = {model.qd[i]: mech.time_derivative(sol[model.q[i]], q, qd, signals=model.signals) for i in deps}
+    sub = {**sol, **rates}
+    s = lambda e: sp.sympify(e).subs(sub)  # noqa: E731
+    forces = {c: s(v) for c, v in model.generalized_forces.items() if c not in names}
+    for c, Qc in model.generalized_forces.items():
+        if c in names:  # virtual work: dq_dep = sum_i d g / d q_i dq_i
+            g = sol[model.coordinate(c)]
+            for i in keep:
+                carried = sp.diff(g, model.q[i])
+                if carried != 0:
+                    cn = model.coordinates[i]
+                    forces[cn] = forces.get(cn, 0) + s(Qc) * carried
+    dep_q = sp.Matrix([sol[model.q[i]] for i in deps])
+    dep_qd = sp.Matrix([rates[model.qd[i]] for i in deps])
+    groups = ["params", "q", "qd"] + (["time"] if TIME in (dep_q.free_symbols | dep_qd.free_symbols) else []) + (
+        ["signals"] if model.signals else [])
+    quantities = dict(model.quantities)
+    quantities["dependent_coordinates"] = (
+        groups, [("q_dep", dep_q), ("qd_dep", dep_qd)],
+        f"Values and rates of the coordinates ({', '.join(names)}) eliminated by the holonomic constraints.")
+    reduced = [c for c in model.reduced if c not in names]
+    out = dataclasses.replace(
+        model, coordinates=[model.coordinates[i] for i in keep],
+        coordinate_units={c: u for c, u in model.coordinate_units.items() if c not in names},
+        q=q, qd=qd, qdd=[model.qdd[i] for i in keep], lagrangian=s(model.lagrangian),
+        dissipation=s(model.dissipation),
+        loads=[Load(sp.Matrix(ld.vector).applyfunc(s), sp.Matrix(ld.velocity).applyfunc(s), ld.name)
+               for ld in model.loads],
+        generalized_forces=forces, symmetric_zero=[c for c in model.symmetric_zero if c not in names],
+        reduced=reduced, holonomic=[], quantities=quantities)
+    info = {"holonomic": [str(c) for c in model.holonomic],
+            "eliminated": {c: str(sol[model.coordinate(c)]) for c in names}}
+    return out, info
+
+
+def multipliers(model: Model, Q, steps):
+    """The derivation with Lagrange multipliers (module docstring)."""
+    from derive.pipeline import Derivation  # the one result type
+
+    phis = _constraints(model)
+    m, n = len(phis), len(model.q)
+    for what, present in (("cyclic coordinates", model.cyclic), ("steady motions", model.steady),
+                          ("given functions", model.given_functions), ("variants", model.variants)):
+        if present:
+            raise Unsupported(f"{model.name}: {what} together with holonomic constraints that need multipliers")
+    explicit = {TIME} | set(model.signal_symbols)
+    if any(c.free_symbols & explicit for c in phis):
+        raise Unsupported(f"{model.name}: a holonomic constraint with explicit time that cannot be solved for "
+                          "dependent coordinates (multipliers at a moving constraint are not derived)")
+    q, qd, qdd = list(model.q), list(model.qd), list(model.qdd)
+    order = model.reduced or [c for c in model.coordinates][: n - m]
+    if len(order) != n - m or not set(order) <= set(model.coordinates):
+        raise Unsupported(f"{model.name}: `reduced` names the {n - m} independent coordinates of a system "
+                          f"with {m} constraints on {n}")
+    ind = [model.coordinates.index(c) for c in order]
+    dep = [i for i in range(n) if i not in ind]
+    lam = sp.symbols(f"lam1:{m + 1}")
+    with steps(f"equations with {m} Lagrange multiplier(s), mass-matrix form of n + m unknowns"):
+        Mq, f = mech.mass_matrix_form(model.lagrangian, q, qd, Q, model.signals)
+        Phi = sp.Matrix(phis)
+        Pq = Phi.jacobian(q)
+        gamma = mech.time_derivative(Pq * sp.Matrix(qd), q, qd)
+        Maug = sp.Matrix(sp.BlockMatrix([[Mq, Pq.T], [Pq, sp.zeros(m, m)]]))
+        faug = sp.Matrix(sp.BlockMatrix([[f], [-gamma]]))
+    zero_inputs = {s: 0 for s in model.input_signal_symbols}
+    rest = {v: 0 for v in qd} | {a: 0 for a in qdd} | zero_inputs
+    with steps("linear operator in the independent coordinates (sympy's linearize at rest)"):
+        E = Mq * sp.Matrix(qdd) - f
+        P_dep, P_ind = Pq.extract(list(range(m)), dep), Pq.extract(list(range(m)), ind)
+        if P_dep.det() == 0:
+            raise Unsupported(f"{model.name}: the constraints cannot be solved for the dependent coordinates "
+                              f"({', '.join(model.coordinates[i] for i in dep)}): choose others in `reduced`")
+        C = sp.zeros(n, n - m)
+        for k, i in enumerate(ind):
+            C[i, k] = 1
+        Cdep = -P_dep.inv() * P_ind
+        for r, i in enumerate(dep):
+            for k in range(n - m):
+                C[i, k] = Cdep[r, k]
+        f0 = f.subs(rest)
+        lam0 = P_dep.T.inv() * sp.Matrix([f0[i] for i in dep])
+        H = sp.zeros(n, n)
+        for j, phi in enumerate(phis):
+            H += lam0[j] * sp.hessian(phi, q)
+        E0 = E.subs({s: 0 for s in zero_inputs})
+        Mr = (C.T * E0.jacobian(qdd).subs(rest) * C).applyfunc(sp.simplify)
+        Dr = (C.T * E0.jacobian(qd).subs(rest) * C).applyfunc(sp.simplify)
+        Kr = (C.T * (E0.jacobian(q).subs(rest) + H) * C).applyfunc(sp.simplify)
+        residual = (C.T * f0).applyfunc(sp.simplify)
+        op = mech.LinearOperator(Mr, Dr, Kr)
+    rq = [q[i] for i in ind]
+    d = Derivation(model=model, mass_matrix=Maug, forcing=faug, routhian=model.lagrangian, rq=rq,
+                   rqd=[qd[i] for i in ind], rqdd=[qdd[i] for i in ind], even=q,
+                   equilibrium_residual=residual, operator=op, route_agreement=None, order=order,
+                   time_dependent=TIME in (Maug.free_symbols | faug.free_symbols))
+    w = list(model.input_signal_symbols)
+    if w:
+        Bq = -E.jacobian(w).subs(rest)
+        B = (C.T * Bq).applyfunc(sp.simplify)
+        keep = [j for j in range(len(w)) if any(B[i, j] != 0 for i in range(B.rows))]
+        d.inputs = [w[j] for j in keep]
+        d.input_matrix = B.extract(list(range(B.rows)), keep) if keep else None
+    quantities = dict(model.quantities)
+    quantities["constraints"] = (["params", "q"], [("phi", Phi), ("Phi_q", Pq)],
+                                 "The holonomic constraints phi(q) (zero on a motion) and their Jacobian.")
+    quantities["constraint_forces"] = (
+        ["params", "q", ("multipliers", list(lam))], [("Qc", -Pq.T * sp.Matrix(lam))],
+        "Constraint forces on the coordinates, -Phi_q' lambda, with lambda the last m unknowns of "
+        "mass_matrix [qdd; lambda] = forcing.")
+    d.model = dataclasses.replace(model, quantities=quantities)
+    d.constraints = {"holonomic": [str(c) for c in phis], "multipliers": [str(x) for x in lam],
+                     "independent": order, "dependent": [model.coordinates[i] for i in dep]}
+    return d

@@ -1,0 +1,300 @@
+"""A model as a sympy.physics.mechanics user writes it, converted once, at the start of the
+derivation, to the machinery's own symbols (`derive/model.py`): plain SymPy symbols for the
+coordinates, their rates and accelerations, with no assumptions.
+
+- Coordinates given as `dynamicsymbols('theta')`: theta(t) becomes the symbol `theta`, its
+  derivative theta' the symbol `theta_d` and theta'' `theta_dd` (or whatever `qd`, `qdd`
+  name). `qd` and `qdd` may be left empty, or given as speeds `dynamicsymbols('u')`: a speed
+  of `qd` stands for the derivative of its coordinate (u_i = q_i'); the machinery derives
+  Lagrange's equations, whose speeds are the coordinates' rates.
+- Any other function of time, F(t), is an input: the `Signal` of that name when the model
+  declares one (its rungs F, F_d, ... for F, F', ...), else an input signal made here of
+  the order the derivation needs, as sympy's linearize takes every such function as an
+  input r.
+- Symbols with assumptions (`symbols('m g l', positive=True)`, coordinates with
+  `real=True`) are the machinery's symbols of the same name.
+- Loads written with `sympy.physics.vector` vectors: `Load(F, v)` with F and v Vectors, or
+  sympy's own loads `(Point, Vector)`, `(ReferenceFrame, Vector)`, `Force`, `Torque` with
+  the model's inertial `frame`: their components in one frame, the velocity of the point
+  (the angular velocity of the body) in `frame`.
+
+Nothing else changes: a model written in plain symbols is returned as it is.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import sympy as sp
+from sympy.core.function import AppliedUndef
+
+from derive.model import TIME, Load, Model, Signal, Unsupported
+
+
+def _is_dynamic(e) -> bool:
+    return isinstance(e, AppliedUndef) and e.args == (TIME,) or (
+        isinstance(e, AppliedUndef) and len(e.args) == 1 and e.args[0].is_Symbol and e.args[0].name == "t")
+
+
+def _plain(s):
+    """The machinery's symbol of that name (no assumptions); s itself when it is one."""
+    if not isinstance(s, sp.Symbol) or type(s) is not sp.Symbol:
+        return s
+    p = sp.Symbol(s.name)
+    return s if p == s else p
+
+
+def _vector_types():
+    try:
+        from sympy.physics.vector import Point, ReferenceFrame, Vector
+    except ImportError:  # pragma: no cover - sympy always has it
+        return None
+    return Vector, Point, ReferenceFrame
+
+
+def _is_vector(x) -> bool:
+    types = _vector_types()
+    return types is not None and isinstance(x, types[0])
+
+
+def _frame_of(*vectors):
+    for v in vectors:
+        for _, frame in getattr(v, "args", ()):
+            return frame
+    return None
+
+
+def _components(vector, frame) -> sp.Matrix:
+    if not _is_vector(vector):
+        return sp.Matrix(vector)
+    if not vector.args:
+        return sp.zeros(3, 1)
+    try:
+        return vector.to_matrix(frame)
+    except Exception as exc:  # frames not oriented to each other
+        raise Unsupported(f"a load's vector cannot be expressed in {frame}: {type(exc).__name__}: "
+                          f"{str(exc).splitlines()[0] if str(exc) else ''}") from None
+
+
+def _load(ld, frame, name: str) -> Load:
+    """A Load with Matrix components, from a Load of Vectors or a sympy load."""
+    Vector, Point, ReferenceFrame = _vector_types()
+    if isinstance(ld, Load):
+        vector, velocity, lname = ld.vector, ld.velocity, ld.name
+        if not (_is_vector(vector) or _is_vector(velocity)):
+            return ld
+    else:
+        where, vector = (ld.location, ld.vector) if hasattr(ld, "location") else tuple(ld)
+        lname = name
+        if frame is None:
+            raise Unsupported(f"{name}: a load given as (point or frame, vector) needs the model's "
+                              "inertial `frame` for the velocity of its point")
+        if isinstance(where, Point):
+            velocity = where.vel(frame)
+        elif isinstance(where, ReferenceFrame):
+            velocity = where.ang_vel_in(frame)
+        else:
+            raise Unsupported(f"{name}: a load acts on a Point or a ReferenceFrame, not {type(where).__name__}")
+    common = _frame_of(vector, velocity) or frame
+    return Load(_components(vector, common), _components(velocity, common), lname)
+
+
+def _dynamic_rates(model: Model):
+    """(map of the coordinates' functions of time and their derivatives to symbols,
+    coordinates, rates, accelerations)."""
+    mapping, q, qd, qdd = {}, [], [], []
+    given_qd, given_qdd = list(model.qd), list(model.qdd)
+    for i, x in enumerate(model.q):
+        dyn = _is_dynamic(x)
+        q.append(sp.Symbol(type(x).__name__) if dyn else _plain(x))
+        if dyn:
+            mapping[x] = q[-1]
+        v = given_qd[i] if i < len(given_qd) else (x.diff(TIME) if dyn else None)
+        a = given_qdd[i] if i < len(given_qdd) else (x.diff(TIME, 2) if dyn else None)
+        if v is None or a is None:
+            raise Unsupported(f"{model.name}: coordinate {model.coordinates[i] if i < len(model.coordinates) else x}: "
+                              "no rate or acceleration given (qd, qdd)")
+        if isinstance(v, sp.Derivative) or _is_dynamic(v):  # q' itself, or a speed u = q'
+            vs = sp.Symbol(f"{q[-1]}_d") if isinstance(v, sp.Derivative) else sp.Symbol(type(v).__name__)
+            mapping[v] = vs
+            if dyn:
+                mapping[x.diff(TIME)] = vs
+        else:
+            vs = _plain(v)
+        qd.append(vs)
+        if isinstance(a, sp.Derivative) or _is_dynamic(a):
+            asym = sp.Symbol(f"{vs}d" if str(vs).endswith("_d") else f"{vs}_d")
+            asym = sp.Symbol(type(a).__name__) if _is_dynamic(a) else asym
+            mapping[a] = asym
+            if dyn:
+                mapping[x.diff(TIME, 2)] = asym
+            if _is_dynamic(v):
+                mapping[v.diff(TIME)] = asym
+        else:
+            asym = _plain(a)
+        qdd.append(asym)
+    return mapping, q, qd, qdd
+
+
+def _exprs(model: Model, loads) -> list:
+    """Every expression of the model that the conversion reads."""
+    out = [model.lagrangian, model.dissipation]
+    out += [c for ld in loads for c in list(ld.vector) + list(ld.velocity)]
+    out += list(model.generalized_forces.values()) + list(model.nonholonomic) + list(model.holonomic)
+    out += list(model.steady.values()) + list(model.cyclic.values())
+    return [sp.sympify(e) for e in out]
+
+
+def _inputs(model: Model, exprs, mapping, known_q) -> tuple[dict, list]:
+    """Functions of time that are neither coordinates nor speeds: the declared signals of
+    their name, or input signals of the order the derivation needs."""
+    declared = {s.name: s for s in model.signals}
+    found: dict[str, int] = {}
+    in_lagrangian: set = set()
+    for j, e in enumerate(exprs):
+        for d in e.atoms(sp.Derivative):
+            f = d.expr
+            if _is_dynamic(f) and f not in known_q and d not in mapping:
+                found[type(f).__name__] = max(found.get(type(f).__name__, 0), d.derivative_count)
+                if j == 0:
+                    in_lagrangian.add(type(f).__name__)
+        for f in e.atoms(AppliedUndef):
+            if _is_dynamic(f) and f not in known_q and f not in mapping:
+                found.setdefault(type(f).__name__, 0)
+                if j == 0:
+                    in_lagrangian.add(type(f).__name__)
+    new, extra = {}, []
+    for name, order in sorted(found.items()):
+        need = order + (1 if name in in_lagrangian else 0)  # Lagrange's d/dt of dL/dqd
+        sig = declared.get(name)
+        if sig is None:
+            sig = Signal(name, "", f"{name}(t), an input given as a function of time", input=True, order=need)
+            extra.append(sig)
+        elif order > sig.order:
+            raise Unsupported(f"{model.name}: the signal {name} appears differentiated {order} times, "
+                              f"beyond its declared order {sig.order}")
+        f = sp.Function(name)(TIME)
+        for k, s in enumerate(sig.symbols[:order + 1]):
+            new[f.diff(TIME, k) if k else f] = s
+    return new, extra
+
+
+def _expression(value, what: str, name: str):
+    """A SymPy expression (or a number) that the machinery can derive, else refused in one
+    line naming what it is: not an expression, a NaN or infinite constant, an integral."""
+    if isinstance(value, (bool, str, bytes)) or value is None:
+        raise Unsupported(f"{name}: {what} is not a SymPy expression (a {type(value).__name__})")
+    if _is_vector(value):
+        raise Unsupported(f"{name}: {what} is a vector, not a scalar expression")
+    try:
+        e = sp.sympify(value, strict=True)
+    except (sp.SympifyError, TypeError, ValueError, AttributeError):
+        raise Unsupported(f"{name}: {what} is not a SymPy expression (a {type(value).__name__})") from None
+    if not isinstance(e, sp.Expr) or isinstance(e, sp.MatrixBase):
+        raise Unsupported(f"{name}: {what} is not a scalar SymPy expression (a {type(e).__name__})")
+    bad = [a for a in e.atoms(sp.Number) if not a.is_finite]
+    if bad or e.has(sp.nan, sp.zoo, sp.oo, -sp.oo):
+        raise Unsupported(f"{name}: {what} has a constant that is not a finite number "
+                          f"({bad[0] if bad else 'nan or oo'})")
+    for kind, why in ((sp.Integral, "an integral"), (sp.Sum, "a sum"), (sp.Piecewise, "a Piecewise (write it "
+                      "with Heaviside, sign, Abs, Max or Min)"), (sp.DiracDelta, "a Dirac delta (an impulse)")):
+        found = e.atoms(kind)
+        if found:
+            raise Unsupported(f"{name}: {what} has {why}, which the machinery cannot derive: {next(iter(found))}")
+    return e
+
+
+def _check_scalars(model: Model) -> None:
+    name = model.name
+    _expression(model.lagrangian, "the Lagrangian", name)
+    _expression(model.dissipation, "the dissipation function", name)
+    for cname, Qc in model.generalized_forces.items():
+        _expression(Qc, f"the generalised force on {cname}", name)
+    for k, c in enumerate(model.holonomic):  # a nonholonomic one is refused as such, whatever it is
+        _expression(c, f"holonomic constraint {k + 1}", name)
+
+
+def _check_expressions(model: Model) -> None:
+    """Every expression of the model that the derivation differentiates, checked."""
+    name = model.name
+    _check_scalars(model)
+    given = set(model.given_functions)
+    exprs = [sp.sympify(model.lagrangian), sp.sympify(model.dissipation)] + [
+        sp.sympify(v) for v in model.generalized_forces.values()]
+    for e in exprs:
+        for f in e.atoms(AppliedUndef):
+            if f not in given:
+                raise Unsupported(f"{name}: {f} is a function that the model does not declare (a function of "
+                                  "time is a dynamicsymbol or a Signal; of a coordinate, a given function)")
+        for dv in e.atoms(sp.Derivative):
+            if dv.expr not in given:
+                raise Unsupported(f"{name}: {dv} is an unevaluated derivative the machinery cannot take")
+    for k, ld in enumerate(model.loads):
+        if not isinstance(ld, Load):
+            raise Unsupported(f"{name}: load {k + 1} is a {type(ld).__name__}, not a Load")
+        for what, vec in (("vector", ld.vector), ("velocity", ld.velocity)):
+            try:
+                comps = sp.Matrix(vec)
+            except Exception:
+                raise Unsupported(f"{name}: load {k + 1} ({ld.name}): its {what} is not a column of "
+                                  f"expressions (a {type(vec).__name__})") from None
+            for c in comps:
+                _expression(c, f"the {what} of load {k + 1} ({ld.name})", name)
+
+
+def convert(model: Model) -> Model:
+    """The model in the machinery's symbols; the model itself when it already is."""
+    _check_scalars(model)
+    out = _convert(model)
+    _check_expressions(out)
+    return out
+
+
+def _convert(model: Model) -> Model:
+    loads = [ld if isinstance(ld, Load) and not (_is_vector(ld.vector) or _is_vector(ld.velocity))
+             else _load(ld, model.frame, f"{model.name}: load {k + 1}") for k, ld in enumerate(model.loads)]
+    mapping, q, qd, qdd = _dynamic_rates(model)
+    exprs = _exprs(model, loads)
+    known = {x for x in model.q if _is_dynamic(x)} | {x for x in model.qd if _is_dynamic(x)}
+    signal_map, extra = _inputs(model, exprs, mapping, known)
+    mapping.update(signal_map)
+    free = set().union(*[e.free_symbols for e in exprs]) | set(model.q) | set(model.qd) | set(model.qdd)
+    mapping.update({s: _plain(s) for s in free if isinstance(s, sp.Symbol) and _plain(s) != s})
+    if not mapping and loads == list(model.loads):
+        return model
+    # derivatives first (their inner functions are replaced with them), then the functions
+    order = sorted(mapping.items(), key=lambda kv: -int(isinstance(kv[0], sp.Derivative)) * (
+        kv[0].derivative_count if isinstance(kv[0], sp.Derivative) else 0))
+    ders = {k: v for k, v in order if isinstance(k, sp.Derivative)}
+    rest = {k: v for k, v in order if not isinstance(k, sp.Derivative)}
+
+    def conv(e):
+        if e is None:
+            return e
+        if isinstance(e, (int, float)):
+            return e
+        if isinstance(e, sp.MatrixBase):
+            return e.applyfunc(conv)
+        e = sp.sympify(e)
+        e = e.xreplace(ders) if ders else e
+        e = e.xreplace(rest) if rest else e
+        left = [f for f in e.atoms(AppliedUndef) if _is_dynamic(f)] + [
+            d for d in e.atoms(sp.Derivative) if _is_dynamic(d.expr)]
+        if left:
+            raise Unsupported(f"{model.name}: {left[0]} is left after converting the functions of time "
+                              "(a derivative of a coordinate beyond its acceleration?)")
+        return e
+
+    def conv_dict(d):
+        return {k: conv(v) for k, v in d.items()}
+
+    quantities = {name: (ins, [(o, conv(sp.Matrix(m))) for o, m in outs], doc)
+                  for name, (ins, outs, doc) in model.quantities.items()}
+    return dataclasses.replace(
+        model, q=q, qd=qd, qdd=qdd, lagrangian=conv(model.lagrangian), dissipation=conv(model.dissipation),
+        loads=[Load(conv(ld.vector), conv(ld.velocity), ld.name) for ld in loads],
+        generalized_forces=conv_dict(model.generalized_forces),
+        nonholonomic=[conv(c) for c in model.nonholonomic], holonomic=[conv(c) for c in model.holonomic],
+        steady=conv_dict(model.steady), cyclic=conv_dict(model.cyclic),
+        equilibrium_approx=conv_dict(model.equilibrium_approx), formulas=conv_dict(model.formulas),
+        quantities=quantities, signals=list(model.signals) + extra,
+        given_functions=[conv(f) for f in model.given_functions])

@@ -255,3 +255,22 @@ def test_cli_contract_boundary_keys(tmp_path):
     assert d["values"] == [["marginal"] * 2, ["stable"] * 2]  # u = 0: an exact zero root
     assert d["boundary"] == [[False] * 2] * 2
     assert (tmp_path / "s.png").stat().st_size > 1000
+
+
+@pytest.mark.parametrize("inertia, rate", [(1e-4, 1), (1e4, 1), (1, 1e-3), (1, 1e3)])
+def test_the_boundaries_are_boundaries_at_every_scale(inertia, rate):
+    """The set on (4.3)'s lambda + theta - chi = 0 with the inertias (A, B, C, J, I, and L
+    with them) scaled by `inertia` and the rates (nu, zeta, eta, and L) by `rate`: the
+    verdicts are homogeneous in both scales, so each boundary of (3.6) and (4.3) stays a
+    boundary. At these scales c11 rounds to exactly 0 and the companion matrix has a
+    computed Jordan block (parallel eigenvectors, an infinite radius): that is a boundary
+    too, not 'unknown', which a map would have shown as unstable (value 0)."""
+    s, t = Fraction(str(inertia)), Fraction(str(rate))
+    for name, (kw, group, _) in ON_BOUNDARY.items():
+        if "1/3 - " in name or "1 + theta" in name:  # certainly unstable there (index 1)
+            continue
+        v = _decimal_set(**_fix(kw))
+        v.update({k: v[k] * s for k in ("A", "B", "C", "J", "I")}, L=v["L"] * s * t)
+        v.update({k: v[k] * t for k in ("nu", "zeta", "eta")})
+        a = ghc.analyse(ghc.model().vector(_floats(v))[None], group == 2)
+        assert a["verdict"].label[0] == "boundary", (name, a["verdict"].label[0], a["verdict"].reason[0])

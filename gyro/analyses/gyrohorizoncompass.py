@@ -189,6 +189,13 @@ def analyse(P: np.ndarray, orbit: np.ndarray | bool = False) -> dict:
     # round to 0 exactly, yet nearby inputs give either sign)
     free = np.where(rounded, 0, free_coordinate(K))
     spec = verdict.spectrum(eig, radius, conservative=True, exact_zero=free)
+    # an infinite radius of a finite eigenvalue is a computed Jordan block (the eigenvectors
+    # exactly parallel: kappa = inf), as where c11 rounds to 0 at a scale other than 1 on
+    # (4.3)'s lambda + theta - chi = 0: rounding decides, a boundary, never 'unknown' (which
+    # the maps have no class for)
+    jordan = ok & (spec.label == "unknown")
+    spec.label[jordan] = "boundary"
+    spec.reason[jordan] = "a defective root (exactly parallel eigenvectors: a Jordan block): rounding decides"
     growth = np.max(eig.real, axis=1)
     stable = ok & ((spec.label == "stable") | sufficient)  # C1 > 0 puts the spectrum on the axis
     # the verdict of the set: (3.6)/(4.3) decided and holding is stable whatever the spectrum;

@@ -274,3 +274,18 @@ def test_the_boundaries_are_boundaries_at_every_scale(inertia, rate):
         v.update({k: v[k] * t for k in ("nu", "zeta", "eta")})
         a = ghc.analyse(ghc.model().vector(_floats(v))[None], group == 2)
         assert a["verdict"].label[0] == "boundary", (name, a["verdict"].label[0], a["verdict"].reason[0])
+
+
+@pytest.mark.parametrize("theta", [0.1, 0.2])
+def test_a_set_just_off_the_row_is_decided_by_its_rows(theta):
+    """chi = 0.32 -+ 1e-13 (exact decimals) with eta != 0, where (3.2) makes lambda = 1 + chi
+    exact: the printed row (1 - 3 chi) nu^2 - eta^2 = +-3e-13 exceeds its bound (9e-15) 30
+    times, and the spectrum's disks decide the same. C1's minors m2..m4 are the rows times
+    m1 and c44 there, so only m1 > 0 and epsilon0 != 0 are required with the rows: the
+    expanded bound of m4 (1.4e-12, against m4 = 1.5e-14) must not make the set a boundary."""
+    below = ghc.analyse(ghc.model().vector(_floats(_decimal_set(chi=Fraction(32, 100) - Fraction(1, 10**13),
+                                                                 theta=theta)))[None])
+    assert below["verdict"].label[0] == "stable" and below["sufficient"][0], below["verdict"].reason[0]
+    above = ghc.analyse(ghc.model().vector(_floats(_decimal_set(chi=Fraction(32, 100) + Fraction(1, 10**13),
+                                                                 theta=theta)))[None])
+    assert above["verdict"].label[0] == "unstable"

@@ -289,3 +289,17 @@ def test_a_set_just_off_the_row_is_decided_by_its_rows(theta):
     above = ghc.analyse(ghc.model().vector(_floats(_decimal_set(chi=Fraction(32, 100) + Fraction(1, 10**13),
                                                                  theta=theta)))[None])
     assert above["verdict"].label[0] == "unstable"
+
+
+def test_a_conservative_spectrum_uses_its_mirror_symmetry():
+    """Hamiltonian roots come as z, -conj(z): a disk wholly left of the axis proves a root
+    right of it (unstable), and 'stable' needs each root's mirror disk to meet no other disk
+    (the argument of the docs), not only the disk itself."""
+    left = verdict.spectrum(np.array([[-1e-8 + 1j, -1e-8 - 1j]]), np.full((1, 2), 1e-9))
+    assert left.label[0] == "unstable"
+    # disk 0 meets the axis and no other disk; its mirror meets disk 1
+    lam = np.array([[1e-9 + 1j, -0.5e-9 + (1 + 2.2e-9) * 1j]])
+    rad = np.array([[1.7e-9, 0.6e-9]])
+    assert not verdict.overlapping(lam, rad).any()
+    assert verdict.spectrum(lam, rad).label[0] == "boundary"
+    assert verdict.spectrum(lam, rad, conservative=False).label[0] == "boundary"  # on the axis: undecided

@@ -255,3 +255,51 @@ def test_cli_contract_boundary_keys(tmp_path):
     assert d["values"] == [["marginal"] * 2, ["stable"] * 2]  # u = 0: an exact zero root
     assert d["boundary"] == [[False] * 2] * 2
     assert (tmp_path / "s.png").stat().st_size > 1000
+
+
+@pytest.mark.parametrize("inertia, rate", [(1e-4, 1), (1e4, 1), (1, 1e-3), (1, 1e3)])
+def test_the_boundaries_are_boundaries_at_every_scale(inertia, rate):
+    """The set on (4.3)'s lambda + theta - chi = 0 with the inertias (A, B, C, J, I, and L
+    with them) scaled by `inertia` and the rates (nu, zeta, eta, and L) by `rate`: the
+    verdicts are homogeneous in both scales, so each boundary of (3.6) and (4.3) stays a
+    boundary. At these scales c11 rounds to exactly 0 and the companion matrix has a
+    computed Jordan block (parallel eigenvectors, an infinite radius): that is a boundary
+    too, not 'unknown', which a map would have shown as unstable (value 0)."""
+    s, t = Fraction(str(inertia)), Fraction(str(rate))
+    for name, (kw, group, _) in ON_BOUNDARY.items():
+        if "1/3 - " in name or "1 + theta" in name:  # certainly unstable there (index 1)
+            continue
+        v = _decimal_set(**_fix(kw))
+        v.update({k: v[k] * s for k in ("A", "B", "C", "J", "I")}, L=v["L"] * s * t)
+        v.update({k: v[k] * t for k in ("nu", "zeta", "eta")})
+        a = ghc.analyse(ghc.model().vector(_floats(v))[None], group == 2)
+        assert a["verdict"].label[0] == "boundary", (name, a["verdict"].label[0], a["verdict"].reason[0])
+
+
+@pytest.mark.parametrize("theta", [0.1, 0.2])
+def test_a_set_just_off_the_row_is_decided_by_its_rows(theta):
+    """chi = 0.32 -+ 1e-13 (exact decimals) with eta != 0, where (3.2) makes lambda = 1 + chi
+    exact: the printed row (1 - 3 chi) nu^2 - eta^2 = +-3e-13 exceeds its bound (9e-15) 30
+    times, and the spectrum's disks decide the same. C1's minors m2..m4 are the rows times
+    m1 and c44 there, so only m1 > 0 and epsilon0 != 0 are required with the rows: the
+    expanded bound of m4 (1.4e-12, against m4 = 1.5e-14) must not make the set a boundary."""
+    below = ghc.analyse(ghc.model().vector(_floats(_decimal_set(chi=Fraction(32, 100) - Fraction(1, 10**13),
+                                                                 theta=theta)))[None])
+    assert below["verdict"].label[0] == "stable" and below["sufficient"][0], below["verdict"].reason[0]
+    above = ghc.analyse(ghc.model().vector(_floats(_decimal_set(chi=Fraction(32, 100) + Fraction(1, 10**13),
+                                                                 theta=theta)))[None])
+    assert above["verdict"].label[0] == "unstable"
+
+
+def test_a_conservative_spectrum_uses_its_mirror_symmetry():
+    """Hamiltonian roots come as z, -conj(z): a disk wholly left of the axis proves a root
+    right of it (unstable), and 'stable' needs each root's mirror disk to meet no other disk
+    (the argument of the docs), not only the disk itself."""
+    left = verdict.spectrum(np.array([[-1e-8 + 1j, -1e-8 - 1j]]), np.full((1, 2), 1e-9))
+    assert left.label[0] == "unstable"
+    # disk 0 meets the axis and no other disk; its mirror meets disk 1
+    lam = np.array([[1e-9 + 1j, -0.5e-9 + (1 + 2.2e-9) * 1j]])
+    rad = np.array([[1.7e-9, 0.6e-9]])
+    assert not verdict.overlapping(lam, rad).any()
+    assert verdict.spectrum(lam, rad).label[0] == "boundary"
+    assert verdict.spectrum(lam, rad, conservative=False).label[0] == "boundary"  # on the axis: undecided

@@ -168,7 +168,18 @@ def analyse(P: np.ndarray, orbit: np.ndarray | bool = False) -> dict:
     exact = np.abs(lam - (1 + tc[:, 1])) <= LAMBDA_TOL * np.maximum(1.0, np.abs(1 + tc[:, 1]))
     orbit = np.broadcast_to(np.asarray(orbit, bool), (n,))
     # the sufficient condition in force at each set, its margins and their rounding bounds
-    which = np.where(orbit, 2, np.where(exact, 1, 0))
+    # 3: (3.6) with eta != 0, where (3.2) makes lambda = 1 + chi exact at the decimal inputs,
+    # so that m2 = m1 I row5, m3 = m2 c22, m4 = m2 c44 row6 exactly: given the printed rows,
+    # C1 > 0 needs only m1 > 0 (zeta != 0) and c44 > 0 (epsilon0 != 0: I lambda zeta/2L < 1).
+    # The expanded bounds of m2..m4 are hundreds of times looser than those of the factored
+    # rows: required, they made a set 1e-13 off the row chi = 0.32 a boundary although its
+    # rows and its spectrum both decide it.
+    which = np.where(orbit, 2, np.where(exact, np.where(P[:, 8] != 0, 3, 1), 0))
+    ratio = 1 - margins[:, :1]
+    # the existence margin 1 - I lambda zeta/2L by the rule of condition_rounding: d = 4
+    # factors, N = 2 terms, k = 2 d + N = 10, sum |t| = 1 + ratio (lambda itself computed as
+    # 1 + (C - B)/I: a few u more, inside the factor)
+    exists_bound = 10 * U * (1 + np.abs(ratio))
     held, decided, why = (np.empty(n, bool), np.empty(n, bool), np.empty(n, object))
     rounded = np.zeros(n, bool)
     # the printed rows are C1 > 0 only given zeta != 0 and epsilon0 != 0 (the paper's own
@@ -177,7 +188,10 @@ def analyse(P: np.ndarray, orbit: np.ndarray | bool = False) -> dict:
     both = lambda a, b: np.concatenate([a, b], axis=1)  # noqa: E731
     for code, marg, bnd, names in ((0, syl, bounds[0], SYLVESTER),
                                    (1, both(c36, syl), both(bounds[1], bounds[0]), C36 + SYLVESTER),
-                                   (2, both(c43, syl), both(bounds[2], bounds[0]), C43 + SYLVESTER)):
+                                   (2, both(c43, syl), both(bounds[2], bounds[0]), C43 + SYLVESTER),
+                                   (3, both(both(c36, syl[:, :1]), margins[:, :1]),
+                                    both(both(bounds[1], bounds[0][:, :1]), exists_bound),
+                                    C36 + SYLVESTER[:1] + ("(3.1) 1 - I lambda zeta/2L",))):
         rows = which == code
         if rows.any():
             held[rows], decided[rows], why[rows] = verdict.condition(marg[rows], bnd[rows], names)
@@ -189,6 +203,13 @@ def analyse(P: np.ndarray, orbit: np.ndarray | bool = False) -> dict:
     # round to 0 exactly, yet nearby inputs give either sign)
     free = np.where(rounded, 0, free_coordinate(K))
     spec = verdict.spectrum(eig, radius, conservative=True, exact_zero=free)
+    # an infinite radius of a finite eigenvalue is a computed Jordan block (the eigenvectors
+    # exactly parallel: kappa = inf), as where c11 rounds to 0 at a scale other than 1 on
+    # (4.3)'s lambda + theta - chi = 0: rounding decides, a boundary, never 'unknown' (which
+    # the maps have no class for)
+    jordan = ok & (spec.label == "unknown")
+    spec.label[jordan] = "boundary"
+    spec.reason[jordan] = "a defective root (exactly parallel eigenvectors: a Jordan block): rounding decides"
     growth = np.max(eig.real, axis=1)
     stable = ok & ((spec.label == "stable") | sufficient)  # C1 > 0 puts the spectrum on the axis
     # the verdict of the set: (3.6)/(4.3) decided and holding is stable whatever the spectrum;

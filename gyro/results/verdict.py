@@ -97,9 +97,11 @@ def spectrum(lam: np.ndarray, radius: np.ndarray, conservative: bool = True,
     lie in the disks |z - lam| <= radius (radius inf or NaN: unbounded; lam not finite:
     failed).
 
-    - unstable: some disk lies in Re z > 0 (a root grows whatever rounding did);
-    - boundary: otherwise, two disks overlap (the exact roots may coincide there: a Krein
-      collision, a Jordan block, a zero root with its mirror image);
+    - unstable: some disk lies in Re z > 0 (a root grows whatever rounding did); when
+      `conservative`, also a disk wholly in Re z < 0 (its mirror root grows);
+    - boundary: otherwise, two disks overlap, or (when `conservative`) a root's mirror disk
+      meets another root's disk (the exact roots may coincide there: a Krein collision, a
+      Jordan block, a zero root with its mirror image);
     - stable: otherwise, when `conservative` (a Hamiltonian spectrum: an isolated disk that
       meets the axis holds one root, and its mirror image -conj(z), which must lie in the
       same disk, is the root itself: it is on the axis); without `conservative` every
@@ -127,8 +129,13 @@ def spectrum(lam: np.ndarray, radius: np.ndarray, conservative: bool = True,
     failed = ~np.all(np.isfinite(lam), axis=1)
     unbounded = ~np.all(np.isfinite(radius), axis=1) & ~failed
     r = np.where(np.isfinite(radius), radius, np.inf)
-    grows = np.any(lam.real > r, axis=1) & ~failed
+    # a conservative (Hamiltonian) spectrum is symmetric about the axis: a disk off the
+    # axis on either side proves a growing root
+    grows = np.any((np.abs(lam.real) if conservative else lam.real) > r, axis=1) & ~failed
     overlap = overlapping(lam, r)
+    if conservative:  # the argument for 'stable' needs each root's mirror disk to meet no other disk
+        d = np.abs(-np.conj(lam)[:, :, None] - lam[:, None, :])
+        overlap |= (d <= r[:, :, None] + r[:, None, :]) & ~np.eye(m, dtype=bool)
     at_zero = np.abs(lam) <= r
     merged = np.any(overlap, axis=(1, 2))
     on_axis = np.any(np.abs(lam.real) <= r, axis=1)

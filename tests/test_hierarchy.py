@@ -112,40 +112,46 @@ def test_the_declared_bounds_are_the_models_small_parameters(tg):
 
 @pytest.fixture(scope="module")
 def torsion_errors(tg):
-    """Every frequency level's error against linear_exact (default method, estimate <= 1e-10:
-    far below every approximate level's bound) on the spread corners and 300 held-out
-    random sets of the spreads (a seed no bench run uses)."""
+    """Every frequency level's error against linear_exact (the default method) on the
+    spread corners and 300 held-out random sets of the spreads (a seed no bench run uses),
+    with the default's own error estimate per mode."""
+    from gyro.questions import frequencies as F
+
     P = np.concatenate([spread_corners(tg), spread_sets(tg, 300, seed=20)])
+    ref = F.answer(tg, hierarchy.get(tg, "linear_exact:default"), P, {})
     out = {}
     for name in ("formulas", "decoupled", "linear_paper", "linear_exact:companion"):
-        out[name] = level_error(tg, "frequencies", name, "linear_exact:default", P)
-    return P, out
+        lv = hierarchy.get(tg, name)
+        ans = F.answer(tg, lv, P, {})
+        bound = hierarchy.bounds(tg, lv, "frequencies", P, 10).total(ans.estimate)
+        out[name] = (ans, F.error(ans, ref), bound)
+    return P, ref, out
 
 
 @pytest.mark.parametrize("name", ["formulas", "decoupled", "linear_paper", "linear_exact:companion"])
 def test_no_bound_is_beaten_on_the_spreads_and_held_out_sets(tg, torsion_errors, name):
     """Wherever a level gives a finite bound outside the question's edges (veering: two
-    modes within their bounds of each other), the measured error is below it. The default
-    method's own error (<= its estimate, about 1e-11 here) is added to the bound: the
-    comparison is against it, not against the exact frequencies."""
+    modes within their bounds of each other), the measured error is below it. The
+    comparison is against the default method, whose own relative error is known to its
+    estimate only (about 1e-11 here; it measured 2.3e-15 at most against the 40-digit
+    reference on the spreads, bench/results/levels.json): that estimate is the allowance."""
     from gyro.questions import frequencies as F
 
-    P, errs = torsion_errors
-    err, bound = errs[name]
-    ans = F.answer(tg, hierarchy.get(tg, name), P, {})
+    P, ref, errs = torsion_errors
+    ans, err, bound = errs[name]
     edge = F.edges(tg, ans, bound, range(10))
     trusted = np.isfinite(bound) & (edge == "")[:, None]
     assert trusted.sum() > 0.3 * trusted.size  # the test holds something
-    ref_err = 1e-10
-    assert np.all(err[trusted] <= bound[trusted] + ref_err), (
-        f"{name}: worst ratio {np.nanmax(err[trusted] / bound[trusted]):.3g}")
+    allow = bound + ref.estimate
+    assert np.all(err[trusted] <= allow[trusted]), (
+        f"{name}: worst ratio {np.nanmax(err[trusted] / allow[trusted]):.3g}")
 
 
 def test_the_approximate_operators_are_close_to_their_bounds_where_they_matter(torsion_errors):
     """The bounds are not vacuous: the worst measured error reaches a tenth of the
     paper operator's bound (the sag terms it carries are the largest it drops)."""
-    _, errs = torsion_errors
-    err, bound = errs["linear_paper"]
+    _, _, errs = torsion_errors
+    _, err, bound = errs["linear_paper"]
     assert np.nanmax(err / bound) > 0.1
 
 
@@ -154,8 +160,9 @@ def test_the_approximate_operators_are_close_to_their_bounds_where_they_matter(t
 
 def test_the_selector_goes_up_the_hierarchy_with_the_tolerance(tg):
     P = tg.vector()
-    picked = [select(tg, "frequencies", P, tol).level[0] for tol in (1e-2, 1e-5, 1e-9, 1e-12)]
-    assert picked == ["linear_paper", "linear_exact:default", "linear_exact:default", "linear_exact:reference"]
+    picked = [select(tg, "frequencies", P, tol).level[0] for tol in (1e-2, 1e-5, 1e-9)]
+    assert picked == ["linear_paper", "linear_exact:default", "linear_exact:default"]
+    # (past the default's bound, the 40-digit reference: test_scene_refuses_in_one_line's 1e-40)
     # the modes the formulas meet at 1e-3 are answered by them, at a fraction of the cost
     s = select(tg, "frequencies", P, 1e-3, {"modes": [1, 2, 4]})
     assert s.level[0] == "formulas" and np.all(s.bound[0] <= 1e-3)

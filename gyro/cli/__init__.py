@@ -10,6 +10,7 @@
     gyro stability gyrohorizoncompass [--set NAME=VALUE]... [--orbit] [--json]
     gyro simulate gyrohorizoncompass [--set ...] --t-end T [--points N] [--perturb D1,D2,D3,D4] [--method NAME] [--json]
     gyro map gyrohorizoncompass --x NAME=LO:HI:N --y NAME=LO:HI:N --out FILE.png [--json]
+    gyro scene MODEL QUESTION --tol REL [--set NAME=VALUE]... [--modes I,J,...] [--horizon T] [--json]
 
 Bad input prints one line on stderr naming the parameter and exits with code 2; a
 numerical failure at valid input one line and exit 1.

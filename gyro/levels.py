@@ -110,6 +110,11 @@ class Bounds:
     estimate: np.ndarray
     invalid: np.ndarray
     answered: np.ndarray | None = None  # (quantities,) False where the level declares no bound
+    bad: np.ndarray | None = None  # (sets,) True beyond an edge (invalid != '')
+
+    def __post_init__(self):
+        if self.bad is None:
+            self.bad = self.invalid != ""
 
     def total(self, own_estimate: np.ndarray | None) -> np.ndarray:
         """The bound per set and quantity: the a-priori part plus, where declared, the
@@ -118,8 +123,8 @@ class Bounds:
         if self.estimate.any():
             own = np.full(b.shape, np.inf) if own_estimate is None else np.asarray(own_estimate, dtype=float)
             b = b + np.where(self.estimate[None, :], own, 0.0)
-        b = np.where(np.isnan(b), np.inf, b)
-        b[self.invalid != ""] = np.inf
+        b[np.isnan(b)] = np.inf
+        b[self.bad] = np.inf
         return b
 
 
@@ -146,9 +151,11 @@ def bounds(model: Model, level: Level, question: str, P: np.ndarray, n_quantitie
             apriori[:, j] = np.abs(rows[:, e["row"]])
         estimate[j] = e["estimate"]
     invalid = np.full(N, "", object)
+    any_bad = np.zeros(N, bool)
     if level.valid:
         margins = _rows(model, "level_validity", P)
         for v in reversed(level.valid):  # the first edge crossed names the reason
             bad = ~(margins[:, v["row"]] > 0)  # NaN: cannot be evaluated there
             invalid[bad] = v["name"]
-    return Bounds(apriori, estimate, invalid, np.array([e is not None for e in entries]))
+            any_bad |= bad
+    return Bounds(apriori, estimate, invalid, np.array([e is not None for e in entries]), any_bad)

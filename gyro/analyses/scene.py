@@ -62,7 +62,7 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
             trial.code[pending], trial.missing = NOT_ANSWERED, ", ".join(missing)
             continue
         pre = B.apriori[:, idx].max(axis=1) if idx else np.zeros(pending.size)
-        beyond = B.invalid != ""
+        beyond = B.bad
         hopeful = ~beyond & (pre <= tol)
         trial.code[pending[beyond]] = EDGE
         trial.text[pending[beyond]] = B.invalid[beyond]
@@ -73,7 +73,7 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
             continue
         ks = pending[sub]
         ans = q.answer(model, lv, P[ks], opts)
-        total = hierarchy.Bounds(B.apriori[sub], B.estimate, B.invalid[sub], B.answered).total(ans.estimate)
+        total = hierarchy.Bounds(B.apriori[sub], B.estimate, B.invalid[sub], B.answered, B.bad[sub]).total(ans.estimate)
         edge = q.edges(model, ans, total, idx)
         worst = total[:, idx].max(axis=1) if idx else np.zeros(sub.size)
         failed, crossed = ans.failed != "", edge != ""
@@ -86,7 +86,7 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
         bound[ks[ok]] = total[ok][:, idx]
         row[ks[ok]] = np.flatnonzero(ok)
         answers[lv.name] = (q, model, ans, idx)
-        pending = np.setdiff1d(pending, ks[ok], assume_unique=True)
+        pending = np.delete(pending, sub[ok])
     return Scene(model.name, question, float(tol), [names[j] for j in idx], level, bound, trials,
                  time.perf_counter() - t0, answers, row)
 

@@ -12,6 +12,7 @@
     gyro map gyrohorizoncompass --x NAME=LO:HI:N --y NAME=LO:HI:N --out FILE.png [--json]
     gyro forced torsion_gyrocompass --harmonic S:K:AMP[:PHASE]... [--set NAME=VALUE]... [--json] [--out FILE.png]
     gyro unbalance MODEL --force-x NAME --force-y NAME --magnitude ME [--phase PHI] [--spin NAME] --spin-range LO HI [--points N] [--set ...] [--json] [--out FILE.png]
+    gyro scene MODEL QUESTION --tol REL [--set NAME=VALUE]... [--modes I,J,...] [--horizon T] [--json]
 
 Bad input prints one line on stderr naming the parameter and exits with code 2; a
 numerical failure at valid input one line and exit 1.

@@ -41,7 +41,8 @@ def _spectrum(model, level, P):
 
     spec = ladder.spectrum(model, P, level.evaluator["method"])
     f, e = spec.frequencies, spec.error_estimate
-    failed = np.where(np.all(np.isfinite(f), axis=1), "", "a frequency could not be computed").astype(object)
+    failed = np.full(f.shape[0], "", object)
+    failed[~np.all(np.isfinite(f), axis=1)] = "a frequency could not be computed"
     return Answer(f, e, failed, {"growth": spec.growth})
 
 
@@ -89,7 +90,8 @@ def _charpoly(model, level, P):
     take = lambda a: np.take_along_axis(a, order, axis=1)  # noqa: E731
     f, g, e = take(freq), take(growth), take(est)
     e = np.where(np.isfinite(e) & (e < 0.5), e, np.inf)
-    failed = np.where(np.all(np.isfinite(f), axis=1), "", "a root could not be computed").astype(object)
+    failed = np.full(f.shape[0], "", object)
+    failed[~np.all(np.isfinite(f), axis=1)] = "a root could not be computed"
     return Answer(f, e, failed, {"growth": g})
 
 

@@ -1,6 +1,7 @@
 """`python -m bench` (or `make bench`): speed of the derivation against a baseline, in one run,
-the accuracy-against-speed chart of the frequency methods (bench/ladder.py) and where the
-formulas' error estimates hold (bench/formula_sweep.py).
+the accuracy-against-speed chart of the frequency methods (bench/ladder.py), where the
+formulas' error estimates hold (bench/formula_sweep.py) and where the default method's time
+goes, against LAPACK in the same run (bench/speed.py).
 
 The baseline derives the same operator J(p) with sympy.physics.mechanics (LagrangesMethod
 and its linearizer, bench/baseline_mechanics.py), bounded by 600 s; this project's
@@ -83,6 +84,7 @@ def main(argv=None) -> int:
         # accuracy against speed of the frequency methods, in a fresh one-thread process
         subprocess.run([sys.executable, "-m", "bench.ladder"], cwd=ROOT, check=True)
         subprocess.run([sys.executable, "-m", "bench.formula_sweep"], cwd=ROOT, check=True)
+        subprocess.run([sys.executable, "-m", "bench.speed"], cwd=ROOT, check=True)
     if args.only == "ladder":
         return 0
     res = bench_derive(args.timeout, args.skip_baseline)

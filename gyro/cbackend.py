@@ -264,6 +264,39 @@ def qep_hermitian(model_name: str) -> QepHermitian:
     return _built(QepHermitian, model_name)
 
 
+class QepBlockStarts:
+    """The generated starts of the refinement (templates/qep_starts.c.j2): per diagonal block,
+    the Hermitian form's eigenvalues without LAPACK and a vector per root by inverse
+    iteration on the block (gyro.qep.block_starts' NumPy path, in C)."""
+
+    def __init__(self, model_name: str):
+        self._fn = _entry(model_name, f"{model_name}_qep_block_starts_batch")
+        self.n = _operator_dim(model_name)
+
+    def __call__(self, M, D, K, blocks, rhs):
+        """M, D, K (sets, n, n); blocks a partition of 0..n-1 into index arrays; rhs (n,)
+        complex. Returns (w, z, ok): w (sets, n) per block descending, z (sets, n, n)
+        complex, ok (sets,) where every block is positive definite with a margin."""
+        M, D, K = (np.ascontiguousarray(X, dtype=float) for X in (M, D, K))
+        N, n = M.shape[0], self.n
+        _check(all(X.shape == (N, n, n) for X in (M, D, K)), f"M, D, K must be (sets, {n}, {n})")
+        idx = np.ascontiguousarray(np.concatenate(blocks), dtype=np.dtype(ctypes.c_long))
+        _check(sorted(idx.tolist()) == list(range(n)), f"blocks must partition 0..{n - 1}")
+        sizes = np.array([len(b) for b in blocks], dtype=np.dtype(ctypes.c_long))
+        rhs = np.ascontiguousarray(rhs, dtype=complex)
+        _check(rhs.shape == (n,), f"rhs must be ({n},)")
+        w, z, ok = np.empty((N, n)), np.empty((N, n, n), complex), np.empty(N)
+        ptr, lptr = ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_long)
+        self._fn(ctypes.c_long(N), ctypes.c_long(len(blocks)), sizes.ctypes.data_as(lptr),
+                 idx.ctypes.data_as(lptr), *[a.ctypes.data_as(ptr) for a in (rhs, M, D, K, w, z, ok)])
+        return w, z, ok.astype(bool)
+
+
+def qep_block_starts(model_name: str) -> QepBlockStarts:
+    """The compiled starts of a model's refinement (CompilerUnavailable when its C has none)."""
+    return _built(QepBlockStarts, model_name)
+
+
 class ModeFormulasSelected:
     """The generated selection and sort of the mode formulas (templates/mode_select.c.j2;
     gyro.ladder.formulas in one pass over the batch)."""

@@ -310,22 +310,67 @@ def pivots_above(A, floor) -> np.ndarray:
     return ok
 
 
+def gyroscopic(M, D, K) -> np.ndarray:
+    """Per set: M and K symmetric and D skew to the bit, the structure the Hermitian forms
+    and the refinement rest on (a damping matrix, a symmetric part of D, moves the roots
+    off the imaginary axis: such sets go to the general rung)."""
+    T = lambda X: X.swapaxes(-1, -2)  # noqa: E731
+    return np.all((M == T(M)) & (K == T(K)) & (D == -T(D)), axis=(-1, -2))
+
+
+def block_vectors(M, D, K, w, blocks_, rhs):
+    """A unit start vector per root (sets, n, n): for the roots w (sets, n) of the blocks,
+    listed block after block, one step of inverse iteration on the block's own
+    J_b(i w) = K_b - w^2 M_b + i w D_b from the fixed rhs, zero outside the block. Its
+    error is the weak coupling between the blocks, so that one step on the full operator
+    mostly meets the tolerance (a shared start vector left 59 % of the roots needing a
+    second step: docs/methods.md)."""
+    N, n = w.shape
+    z = np.zeros((N, n, n), complex)
+    off = 0
+    for b in blocks_:
+        nb = len(b)
+        wb = w[:, off:off + nb, None, None]
+        Mb, Db, Kb = (X[:, b][:, :, b][:, None] for X in (M, D, K))
+        x = None
+        for shift in (0.0, 64 * EPS, 1e-10, 1e-7):  # as in rayleigh_step: a root to the last bit
+            ws = wb * (1 + shift)
+            try:
+                x = np.linalg.solve(Kb - ws**2 * Mb + 1j * ws * Db,
+                                    np.broadcast_to(rhs[b], (N, nb, nb))[..., None])[..., 0]
+                break
+            except np.linalg.LinAlgError:
+                continue
+        if x is None:
+            return z, np.zeros(N, bool)
+        z[:, off:off + nb, b] = x
+        off += nb
+    nrm = np.linalg.norm(z, axis=-1, keepdims=True)
+    fine = np.all(np.isfinite(nrm[..., 0]) & (nrm[..., 0] > 0), axis=1)
+    with np.errstate(all="ignore"):
+        return z / nrm, fine
+
+
 def block_starts(model: Model, M, D, K, good):
-    """Which sets take the Hermitian path (K > 0 and M > 0 in every diagonal block, with a
-    margin) and, for those, the block problems' frequencies (sets taken, n): the starts of
-    the refinement. Compiled: the model's generated block form (templates/qep.c.j2), whose
-    Cholesky pivots must exceed 1e3 eps; without a compiler: the same test on the leading
-    principal minors (pivots_above), then hermitian_block."""
-    kernel = compiled(cbackend.qep_hermitian, model)
+    """Which sets take the Hermitian path (gyroscopic: M, K symmetric and D skew; K > 0 and
+    M > 0 in every diagonal block, with a margin) and, for those, the block problems' frequencies (sets taken, n) and a vector
+    per root (sets taken, n, n): the starts of the refinement. Compiled: the model's
+    generated block forms and their eigenvalues without LAPACK (templates/qep_starts.c.j2),
+    whose Cholesky pivots must exceed 1e3 eps; without a compiler: the same test on the
+    leading principal minors (pivots_above), hermitian_block and block_vectors."""
+    kernel = compiled(cbackend.qep_block_starts, model)
     blocks_ = blocks(model)
+    n = M.shape[-1]
+    rhs = start_vectors(1, n, 1)[0, 0]
     if kernel is not None:
-        forms = [kernel(M, D, K, b) for b in blocks_]
-        herm = good & np.all([ok for _, ok in forms], axis=0)
-        take = slice(None) if herm.all() else np.flatnonzero(herm)  # no copy when all take it
-        mu = [np.linalg.eigvalsh(T[take])[:, len(b):] for (T, _), b in zip(forms, blocks_)]
-        return herm, 1 / np.concatenate(mu, axis=1)  # mu ascending: w descending per block
+        w, z, ok = kernel(M, D, K, blocks_, rhs)
+        herm = good & ok
+        if herm.all():  # no copy when all take it
+            return herm, w, z
+        h = np.flatnonzero(herm)
+        return herm, w[h], z[h]
     dK, dM = np.einsum("bii->bi", K), np.einsum("bii->bi", M)
-    herm = good & np.all(dK > 0, axis=1) & np.all(dM > 0, axis=1)
+    herm = good & np.all(dK > 0, axis=1) & np.all(dM > 0, axis=1) & gyroscopic(M, D, K)
     for b in blocks_:
         for X, d in ((K, dK), (M, dM)):
             with np.errstate(all="ignore"):
@@ -333,5 +378,8 @@ def block_starts(model: Model, M, D, K, good):
                 herm &= pivots_above(X[:, b][:, :, b] * s[:, :, None] * s[:, None, :], 1e3 * EPS)
     h = np.flatnonzero(herm)
     Mh, Dh, Kh = M[h], D[h], K[h]
-    return herm, np.concatenate([hermitian_block(Mh[:, b][:, :, b], Dh[:, b][:, :, b], Kh[:, b][:, :, b])
-                                 for b in blocks_], axis=1)
+    w = np.concatenate([hermitian_block(Mh[:, b][:, :, b], Dh[:, b][:, :, b], Kh[:, b][:, :, b])
+                        for b in blocks_], axis=1)
+    z, fine = block_vectors(Mh, Dh, Kh, w, blocks_, rhs)
+    herm[h[~fine]] = False
+    return herm, w[fine], z[fine]

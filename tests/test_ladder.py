@@ -375,6 +375,7 @@ def _without_compiler(monkeypatch) -> list:
 
     monkeypatch.setattr(cbackend, "qep_refine", unavailable)
     monkeypatch.setattr(cbackend, "qep_hermitian", unavailable)
+    monkeypatch.setattr(cbackend, "qep_block_starts", unavailable)
     monkeypatch.setattr(cbackend, "mode_formulas_selected", unavailable)
     return refused
 

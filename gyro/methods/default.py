@@ -45,15 +45,14 @@ def solve(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
     good = ok & tame(M) & tame(D) & tame(K)
     # which rung answered; "none" where no rung could (no equilibrium in any precision)
     route = np.where(good, "structured", "none").astype(object)
-    # the structured path assumes a conservative gyroscopic operator (D skew); a set with
-    # dissipation (D + D^T != 0, bearing damping) takes the general rung, which has growth
-    conservative = np.all(D == -np.swapaxes(D, -1, -2), axis=(-2, -1))
-    herm, w0 = qep.block_starts(model, M, D, K, good & conservative)
+    # the structured path assumes a conservative gyroscopic operator (M, K symmetric, D skew
+    # to the bit); block_starts hands any other set (bearing damping) to the general rung
+    herm, w0, z0 = qep.block_starts(model, M, D, K, good)
     h = np.flatnonzero(herm)
     if h.size:
         take = slice(None) if h.size == N else h
         Mh, Dh, Kh = M[take], D[take], K[take]
-        w, z, e, fine = qep.rayleigh(model, Mh, Dh, Kh, w0, qep.start_vectors(h.size, n, n), 3, tol)
+        w, z, e, fine = qep.rayleigh(model, Mh, Dh, Kh, w0, z0, 3, tol)
         ws_sorted = np.sort(w, axis=1)
         distinct = np.all(np.diff(ws_sorted, axis=1) > 1e-8 * ws_sorted[:, 1:], axis=1)
         # a root far below the others (omega1 -> 0 toward the pole or as u -> 0) carries the

@@ -1,0 +1,170 @@
+"""This project's generated C against CasADi's own C code generator, function by function.
+
+`python -m bench.codegen_casadi [--evals N] [--repeats R]`: for every emitted function of
+every generated model, casadi.CodeGenerator writes C for the same casadi.Function (the one
+in generated/<model>/casadi_functions.py). Both are compiled by the same compiler with the
+same flags (gyro.cbackend.FLAGS without -shared and -fPIC) into one harness that calls each
+through a function pointer N times on the model's defaults (a pointer call across
+translation units: nothing inlined or hoisted), alternating ours and CasADi's, R times. The
+figures are medians in ns per evaluation and the ratio ours / CasADi's (< 1: ours faster),
+measured in the same process on a shared machine. CasADi writes only the structural
+nonzeros of an output (its caller zeroes the rest once); ours writes every entry: the
+column "outputs (CasADi nonzeros)" shows where that counts. Writes bench/results/codegen_casadi.json
+and the table bench/results/codegen_casadi.md.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from gyro import cbackend, load
+from gyro.catalog import available
+
+ROOT = Path(__file__).resolve().parent.parent
+RESULTS = ROOT / "bench" / "results"
+FLAGS = [f for f in cbackend.FLAGS if f not in ("-shared", "-fPIC")]
+
+HARNESS = r"""#define _POSIX_C_SOURCE 199309L
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+typedef long long casadi_int;
+%(decls)s
+static double now(void) { struct timespec t; clock_gettime(CLOCK_MONOTONIC, &t); return t.tv_sec + 1e-9 * t.tv_nsec; }
+int main(int argc, char **argv)
+{
+    const long evals = atol(argv[1]), repeats = atol(argv[2]);
+    volatile double sink = 0.0;
+%(body)s
+    return 0;
+}
+"""
+
+
+def inputs_for(model, fname) -> list[np.ndarray]:
+    """The defaults for params, the approximate equilibrium for qe, 0.1 elsewhere."""
+    meta = model.meta["functions"][fname]
+    p = model.vector(model.defaults)
+    out = []
+    for inp in meta["inputs"]:
+        k = len(inp["symbols"])
+        if inp["name"] == "params":
+            out.append(p)
+        elif inp["name"] == "qe" and "equilibrium_approx" in model.meta["functions"]:
+            out.append(np.ravel(model.numpy.equilibrium_approx(p))[:k])
+        else:
+            out.append(np.full(k, 0.1))
+    return out
+
+
+def one_model(name: str, evals: int, repeats: int, tmp: Path) -> list[dict]:
+    import casadi as ca
+
+    model = load(name)
+    cas = importlib.import_module(f"gyro.generated.{name}.casadi_functions")
+    src = Path(model.directory) / f"{name}.c"
+    decls, body, rows = [], [], []
+    cg = ca.CodeGenerator(f"cas_{name}.c", {"with_header": False})
+    for fname, meta in model.meta["functions"].items():
+        f = getattr(cas, fname, None)
+        if not isinstance(f, ca.Function):
+            continue
+        cg.add(f)
+        ins = inputs_for(model, fname)
+        outs = [o["shape"][0] * o["shape"][1] for o in meta["outputs"]]
+        i = len(rows)
+        rows.append({"model": name, "function": fname, "outputs": int(sum(outs)),
+                     "output_nonzeros_casadi": int(sum(f.nnz_out(j) for j in range(f.n_out())))})
+        decls.append(f"void {name}_{fname}({', '.join(['const double *'] * len(ins) + ['double *'] * len(outs))});")
+        decls.append(f"int {fname}(const double **, double **, casadi_int *, double *, int);")
+        decls.append(f"int {fname}_work(casadi_int *, casadi_int *, casadi_int *, casadi_int *);")
+        lines = [f"  {{ /* {fname} */"]
+        for j, x in enumerate(ins):
+            vals = ", ".join(repr(float(v)) for v in x) or "0.0"
+            lines.append(f"    static double in{j}[] = {{{vals}}};")
+        for j, k in enumerate(outs):
+            lines.append(f"    static double out{j}[{k}];")
+        lines.append("    casadi_int na, nr, niw, nw;")
+        lines.append(f"    {fname}_work(&na, &nr, &niw, &nw);")
+        lines.append("    const double **arg = calloc(na + 1, sizeof(double *)); double **res = calloc(nr + 1, sizeof(double *));")
+        lines.append("    casadi_int *iw = calloc(niw + 1, sizeof(casadi_int)); double *w = calloc(nw + 1, sizeof(double));")
+        for j in range(len(ins)):
+            lines.append(f"    arg[{j}] = in{j};")
+        for j in range(len(outs)):
+            lines.append(f"    res[{j}] = out{j};")
+        ours_args = ", ".join([f"in{j}" for j in range(len(ins))] + [f"out{j}" for j in range(len(outs))])
+        lines.append(f"    void (*volatile ours)({', '.join(['const double *'] * len(ins) + ['double *'] * len(outs))}) = {name}_{fname};")
+        lines.append(f"    int (*volatile theirs)(const double **, double **, casadi_int *, double *, int) = {fname};")
+        lines.append("    for (long r = 0; r < repeats; ++r) {")
+        lines.append(f"      double t0 = now(); for (long e = 0; e < evals; ++e) {{ ours({ours_args}); sink += out0[0]; }}")
+        lines.append("      double t1 = now(); for (long e = 0; e < evals; ++e) { theirs(arg, res, iw, w, 0); sink += out0[0]; }")
+        lines.append(f"      double t2 = now(); printf(\"%d %.6e %.6e\\n\", (t1 - t0) / evals, (t2 - t1) / evals);", )
+        lines.append("    }")
+        lines.append("  }")
+        body.append("\n".join(lines).replace("%d", str(i)))
+    cg.generate(str(tmp) + "/")
+    harness = tmp / f"harness_{name}.c"
+    harness.write_text(HARNESS % {"decls": "\n".join(decls), "body": "\n".join(body)})
+    exe = tmp / f"harness_{name}"
+    objs = []
+    for c in (src, tmp / f"cas_{name}.c", harness):
+        o = tmp / (c.stem + ".o")
+        proc = subprocess.run(["gcc", *FLAGS, "-I", str(src.parent), "-c", str(c), "-o", str(o)],
+                              capture_output=True, text=True)
+        if proc.returncode:
+            raise RuntimeError(f"gcc failed on {c.name}: {proc.stderr[:2000]}")
+        objs.append(str(o))
+    subprocess.run(["gcc", *objs, "-o", str(exe), "-lm"], check=True)
+    out = subprocess.run([str(exe), str(evals), str(repeats)], check=True, capture_output=True, text=True).stdout
+    times: dict[int, list[tuple[float, float]]] = {}
+    for line in out.split("\n"):
+        if line.strip():
+            k, a, b = line.split()
+            times.setdefault(int(k), []).append((float(a), float(b)))
+    for k, row in enumerate(rows):
+        a = np.array(times[k])
+        row["ours_ns"] = float(np.median(a[:, 0]) * 1e9)
+        row["casadi_ns"] = float(np.median(a[:, 1]) * 1e9)
+        row["ratio_ours_over_casadi"] = row["ours_ns"] / row["casadi_ns"]
+    return rows
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m bench.codegen_casadi", description=__doc__.splitlines()[0])
+    ap.add_argument("--evals", type=int, default=2000)
+    ap.add_argument("--repeats", type=int, default=51)
+    args = ap.parse_args(argv)
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in available():
+            print(f"{name}: CasADi's code generator and ours, same compiler and flags ...", flush=True)
+            rows += one_model(name, args.evals, args.repeats, Path(tmp))
+    lines = ["| model | function | outputs (CasADi nonzeros) | ours ns/eval | CasADi ns/eval | ours / CasADi |",
+             "|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['model']} | {r['function']} | {r['outputs']} ({r['output_nonzeros_casadi']}) | "
+                     f"{r['ours_ns']:.1f} | {r['casadi_ns']:.1f} | {r['ratio_ours_over_casadi']:.2f} |")
+        print(f"  {r['model']:22s} {r['function']:22s} ours {r['ours_ns']:9.1f} ns  CasADi {r['casadi_ns']:9.1f} ns"
+              f"  ratio {r['ratio_ours_over_casadi']:.2f}")
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    note = (f"Medians of {args.repeats} runs of {args.evals} evaluations each, ours and CasADi's alternating "
+            f"in one process on a shared machine; gcc {' '.join(FLAGS)}.")
+    (RESULTS / "codegen_casadi.md").write_text("\n".join(["# Generated C against casadi.CodeGenerator", "", note, "", *lines]) + "\n")
+    (RESULTS / "codegen_casadi.json").write_text(json.dumps({"note": note, "rows": rows}, indent=1) + "\n")
+    slower = [r for r in rows if r["ratio_ours_over_casadi"] > 1]
+    print(f"{len(rows) - len(slower)} of {len(rows)} functions at least as fast as CasADi's code; written "
+          f"bench/results/codegen_casadi.md")
+    return 0
+
+
+if __name__ == "__main__":
+    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    sys.exit(main())

@@ -178,6 +178,11 @@ class Model:
     # error estimate as an expression in the parameters), ...]); the runtime takes, per
     # parameter set and mode, the candidate whose own estimate is smallest
     mode_formulas: list = field(default_factory=list)
+    # the spin, for Campbell diagrams and harmonic lines (derive/outputs/spin.py):
+    # {"parameter": name of the parameter that sets it, "rate": the spin rate in rad/s as an
+    # expression of the parameters (default: the parameter itself), "whirl": [(a, b), ...]
+    # pairs of reduced coordinates whose orbit a -> b turns with the spin (forward whirl)}
+    spin: dict = field(default_factory=dict)
 
     @property
     def signal_symbols(self) -> list:

@@ -37,9 +37,13 @@ def as_batch(model: Model, params) -> np.ndarray:
     return P
 
 
-def spectrum(model: Model, params, method: str = "default", tol: float = DEFAULT_TOL) -> Spectrum:
+def spectrum(model: Model, params, method: str = "default", tol: float = DEFAULT_TOL,
+             modes: bool = False) -> Spectrum:
     """Natural frequencies of a batch of parameter sets (rows of `params`, in the order of
-    model.param_names) by one method of the ladder."""
+    model.param_names) by one method of the ladder; with `modes`, the right eigenvectors
+    too (Spectrum.modes: with_modes)."""
+    if modes:
+        return with_modes(model, params, spectrum(model, params, method, tol))
     if method not in METHODS:
         raise ValueError(f"method: unknown {method!r}; known: {', '.join(METHODS)}")
     P = as_batch(model, params)
@@ -49,6 +53,21 @@ def spectrum(model: Model, params, method: str = "default", tol: float = DEFAULT
         return Spectrum(method, empty, empty.copy(), empty.copy(),
                         np.zeros((0, len(model.meta["equilibrium_coordinates"]))), np.zeros(0, object))
     return get(method).solve(model, P, tol)
+
+
+def with_modes(model: Model, params, spec: Spectrum) -> Spectrum:
+    """The spectrum with its mode shapes: for each root lambda = growth + i omega, the right
+    eigenvector of J(lambda) about the set's equilibrium (gyro.qep.eigenvectors), over the
+    reduced coordinates in their own units."""
+    from dataclasses import replace
+
+    from gyro import qep
+    from gyro.equilibrium import equilibria, operators
+
+    P = as_batch(model, params)
+    qe = spec.equilibrium if spec.equilibrium is not None else equilibria(model, P)[0]
+    M, D, K = operators(model, P, qe)
+    return replace(spec, modes=qep.eigenvectors(M, D, K, spec.growth + 1j * spec.frequencies))
 
 
 def natural_frequencies(model: Model, values: dict, method: str = "default") -> ModalResult:

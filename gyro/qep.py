@@ -335,3 +335,22 @@ def block_starts(model: Model, M, D, K, good):
     Mh, Dh, Kh = M[h], D[h], K[h]
     return herm, np.concatenate([hermitian_block(Mh[:, b][:, :, b], Dh[:, b][:, :, b], Kh[:, b][:, :, b])
                                  for b in blocks_], axis=1)
+
+
+def eigenvectors(M, D, K, lam) -> np.ndarray:
+    """Right eigenvectors x of J(lambda) x = 0 for a batch: M, D, K (B, n, n), roots lam
+    (B, r); x (B, r, n) the right singular vector of J(lambda) at its smallest singular value,
+    of unit length, its largest component real and positive (a mode shape, in the
+    coordinates' own units). NaN where lambda is not finite."""
+    lam = np.asarray(lam, complex)
+    good = np.isfinite(lam)
+    lz = np.where(good, lam, 0.0)[..., None, None]
+    J = M[:, None] * lz**2 + D[:, None] * lz + K[:, None]
+    with np.errstate(all="ignore"):
+        J = np.where(np.isfinite(J), J, 0.0)
+        x = np.linalg.svd(J)[2][..., -1, :].conj()
+    big = np.take_along_axis(x, np.argmax(np.abs(x), axis=-1)[..., None], axis=-1)
+    x = x * (np.abs(big) / np.where(big == 0, 1.0, big))
+    x /= np.maximum(np.linalg.norm(x, axis=-1, keepdims=True), 1e-300)
+    x[~good] = np.nan
+    return x

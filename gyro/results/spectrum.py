@@ -21,6 +21,23 @@ class Spectrum:
     equilibrium: np.ndarray | None = None  # (sets, equilibrium coordinates)
     route: np.ndarray = field(default=None)  # per set: which rung answered (default only)
     growth_known: bool = True  # False for a method that computes no growth rates (formulas)
+    modes: np.ndarray | None = None  # (sets, modes, coordinates) complex right eigenvectors, on request
+
+    def damping_ratio(self) -> np.ndarray:
+        """zeta = -Re(lambda)/|lambda| per root (0 for an undamped one, NaN at lambda = 0)."""
+        with np.errstate(all="ignore"):
+            return -self.growth / np.abs(self.growth + 1j * self.frequencies)
+
+    def log_dec(self) -> np.ndarray:
+        """Logarithmic decrement delta = -2 pi Re(lambda)/Im(lambda) per root (the decay of
+        the amplitude over one damped period); NaN for a root that does not oscillate."""
+        with np.errstate(all="ignore"):
+            return np.where(self.frequencies > 0, -2 * np.pi * self.growth / self.frequencies, np.nan)
+
+    @property
+    def damped(self) -> bool:
+        """Any root with a growth rate that is not zero (the text table then shows damping)."""
+        return bool(self.growth_known and np.any(np.abs(np.nan_to_num(self.growth)) > 0))
 
     def __len__(self) -> int:
         return self.frequencies.shape[0]
@@ -29,7 +46,7 @@ class Spectrum:
     def concat(cls, parts: list["Spectrum"]) -> "Spectrum":
         """One spectrum of the sets of several, in order."""
         cat = {f: (None if getattr(parts[0], f) is None else np.concatenate([getattr(x, f) for x in parts]))
-               for f in ("frequencies", "growth", "error_estimate", "equilibrium", "route")}
+               for f in ("frequencies", "growth", "error_estimate", "equilibrium", "route", "modes")}
         return cls(parts[0].method, **cat, growth_known=all(p.growth_known for p in parts))
 
     def to_dict(self, k: int, model, params: dict) -> dict:
@@ -47,7 +64,15 @@ class Spectrum:
             "error_estimate": [float(e) if np.isfinite(e) else None for e in self.error_estimate[k]],
             "stability": {"class": str(stab.label[k]), "growth_rate": float(stab.growth_rate[k]),
                           "unstable_roots": int(stab.unstable_roots[k])},
-        }
+        } | (self.modes_dict(k, model) if self.modes is not None else {})
+
+    def modes_dict(self, k: int, model) -> dict:
+        """`gyro frequencies --modes`: damping ratio, logarithmic decrement and one right
+        eigenvector per frequency (coordinates in the `reduced` order, {re, im} lists)."""
+        num = lambda a: [float(x) if np.isfinite(x) else None for x in a]  # noqa: E731
+        return {"damping_ratio": num(self.damping_ratio()[k]), "log_dec": num(self.log_dec()[k]),
+                "coordinates": list(model.meta["reduced"]),
+                "modes": [{"re": num(v.real), "im": num(v.imag)} for v in self.modes[k]]}
 
     def table(self, k: int, model) -> str:
         """The `gyro frequencies` text of set k."""
@@ -56,12 +81,16 @@ class Spectrum:
         lines = [f"{model.meta['title']} ({model.name})",
                  f"natural frequencies by the method '{self.method}'"
                  + (f" (answered by its {self.route[k]} rung)" if self.route is not None else "") + ":",
-                 f"{'':>4} {'omega [rad/s]':>16} {'f [Hz]':>14} {'period [s]':>14} {'rel. error <=':>14}"]
+                 f"{'':>4} {'omega [rad/s]':>16} {'f [Hz]':>14} {'period [s]':>14} {'rel. error <=':>14}"
+                 + (f" {'damping ratio':>14} {'log. decr.':>11}" if self.damped else "")]
+        zeta, delta = self.damping_ratio()[k], self.log_dec()[k]
         lam = np.abs(self.growth[k] + 1j * freqs)
         grows = (self.growth[k] > np.maximum(np.where(np.isfinite(est), est, np.inf), 1e-9) * lam) & np.isfinite(est)
         for i, (w, e) in enumerate(zip(freqs, est), 1):
             period = 2 * np.pi / w if w > 0 else float("inf")
             row = f"{i:>4} {w:>16.9g} {w / (2 * np.pi):>14.6g} {period:>14.6g} {e:>14.2g}"
+            if self.damped:
+                row += f" {zeta[i - 1]:>14.6g} {delta[i - 1]:>11.5g}"
             if grows[i - 1]:
                 row += f"   grows at {self.growth[k][i - 1]:.6g} 1/s"
             lines.append(row)

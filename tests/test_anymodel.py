@@ -110,3 +110,88 @@ def test_models_from_anywhere_at_the_command_line(rotor, tmp_path):
     notmodel.write_text("x = 1\n")
     rc, out, err = run_cli("frequencies", str(notmodel))
     assert rc == 2 and "not a model" in err.strip().splitlines()[-1] and out == ""
+
+
+@pytest.fixture(scope="session")
+def rotor_campbell(rotor):
+    from gyro.analyses.campbell import campbell
+
+    return campbell(rotor, rotor.defaults, None, np.linspace(0.0, 1500.0, 31), harmonics=(1, 2))
+
+
+def test_campbell_crossings_are_the_closed_forms_critical_speeds(rotor, rotor_campbell):
+    """Each crossing: at its spin, the closed form has a root with Im(lambda) = k Omega. Brent's
+    method stops at 4 eps relative in Omega; the root's slope in Omega is below 1, so the
+    mismatch is ~1e-15 relative; 1e-10 allows the default method's bound (1e-10) and no
+    more. A crossing read off the 50 rad/s grid would be off by up to 1e-2."""
+    d = rotor_campbell
+    assert {(c.k, c.mode) for c in d.crossings} == {(k, j) for k in (1, 2) for j in (1, 2, 3, 4)}
+    for c in d.crossings:
+        lam = exact_roots(*closed_form(rotor.parameters({"Omega": c.value})))
+        assert np.min(np.abs(lam.imag - c.k * c.value)) <= 1e-10 * c.k * c.value
+        assert c.spin_rate == c.value and abs(c.frequency - c.k * c.value) <= 1e-10 * c.frequency
+
+
+def test_campbell_tracks_modes_and_tells_whirl_from_the_gyroscopic_effect(rotor, rotor_campbell):
+    """Tracked, not sorted: each column is one mode (its eigenvector's MAC with the next point's
+    stays near 1). Forward whirl stiffens with spin, backward softens (Ip Omega couples the
+    tilts): the frequency of every point labelled forward rises, of every backward one falls,
+    at high spin where the gyroscopic term dominates the bearing anisotropy."""
+    from gyro.analyses.campbell import mac
+
+    d = rotor_campbell
+    t = d.tracked
+    for i in range(len(d.Omega) - 1):
+        m = np.diag(mac(t.modes[i], t.modes[i + 1]))
+        assert np.all(m > 0.9), (i, m)
+    lam = np.array([exact_roots(*closed_form(rotor.parameters({"Omega": w})))
+                    for w in d.values_swept])
+    assert np.allclose(np.sort(t.frequencies, axis=1), lam.imag, rtol=1e-10, atol=0)
+    slope = np.diff(t.frequencies, axis=0)[-5:]
+    wh = d.whirl[-6:-1]
+    assert np.all(slope[wh == "forward"] > 0) and np.all(slope[wh == "backward"] < 0)
+    assert (wh == "forward").any() and (wh == "backward").any()
+    assert list(d.whirl[0]) == ["mixed"] * 4  # no spin: no gyroscopic coupling, flat orbits
+    zeta = t.damping_ratio()
+    assert np.allclose(zeta, -lam_tracked(t).real / np.abs(lam_tracked(t)))
+    assert np.allclose(t.log_dec(), 2 * np.pi * zeta / np.sqrt(1 - zeta**2), rtol=1e-12)
+
+
+def lam_tracked(t):
+    return t.growth + 1j * t.frequencies
+
+
+def test_campbell_json_contract_and_bad_input(rotor, tmp_path):
+    rc, out, err = run_cli("campbell", str(ROTOR_FILE), "--spin-range", "0", "1000", "--points", "6",
+                           "--harmonics", "1", "--json", "--out", str(tmp_path / "c.png"), "--quiet")
+    assert rc == 0, err
+    doc = json.loads(out)
+    assert set(doc) >= {"model", "spin", "values", "spin_rate", "frequencies", "growth", "damping_ratio",
+                        "log_dec", "whirl", "crossings"}
+    assert doc["spin"] == "Omega" and doc["values"][0] == 0.0 and len(doc["frequencies"]) == 6
+    assert set(doc["crossings"][0]) == {"k", "mode", "value", "spin_rate", "frequency"}
+    assert (tmp_path / "c.png").read_bytes()[:4] == b"\x89PNG"
+    for args, word in ((["--spin-range", "-1", "10"], "--spin-range"), (["--spin", "m"], "--spin"),
+                       (["--spin", "nope"], "--spin"), (["--harmonics", "1,x"], "--harmonics"),
+                       (["--spin-range", "0", "10"], "--out")):
+        extra = [] if word == "--out" else ["--json"]
+        rc, out, err = run_cli("campbell", str(ROTOR_FILE), *args, *extra, "--quiet")
+        assert rc == 2 and word in err and len(err.strip().splitlines()) == 1 and out == "", (args, err)
+
+
+def test_modes_are_the_closed_forms_eigenvectors(rotor):
+    """`gyro frequencies --modes`: J(lambda) x = 0 for each mode of the closed form, to the
+    rounding of J (entries up to 3e6: |J x| <= 1e-9 |J|, |x| = 1)."""
+    rc, out, err = run_cli("frequencies", str(ROTOR_FILE), "--set", "Omega=450", "--modes", "--json")
+    assert rc == 0, err
+    doc = json.loads(out)
+    M, D, K = closed_form(rotor.parameters({"Omega": 450.0}))
+    for w, g, mode in zip(doc["frequencies"], doc["eigenvalues_re"], doc["modes"]):
+        lam = g + 1j * w
+        x = np.array(mode["re"]) + 1j * np.array(mode["im"])
+        J = M * lam**2 + D * lam + K
+        assert abs(np.linalg.norm(x) - 1) < 1e-12
+        assert np.linalg.norm(J @ x) <= 1e-9 * np.abs(J).max()
+    assert doc["coordinates"] == ["x", "y", "alpha", "beta"] and len(doc["damping_ratio"]) == 4
+    rc, out, err = run_cli("frequencies", str(ROTOR_FILE))
+    assert "damping ratio" in out and "log. decr." in out

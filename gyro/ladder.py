@@ -52,7 +52,28 @@ def spectrum(model: Model, params, method: str = "default", tol: float = DEFAULT
         empty = np.zeros((0, n))
         return Spectrum(method, empty, empty.copy(), empty.copy(),
                         np.zeros((0, len(model.meta["equilibrium_coordinates"]))), np.zeros(0, object))
-    return get(method).solve(model, P, tol)
+    return steady_roots(model, get(method).solve(model, P, tol))
+
+
+def steady_roots(model: Model, spec: Spectrum) -> Spectrum:
+    """Mark the zero roots that steadily turning coordinates own (Spectrum.steady). Such a
+    coordinate is absent from L and the forces (the derivation proves it), so K e_c = 0 and
+    lambda = 0 is a root of each, exactly: per set, the len(steady) roots of smallest
+    |lambda|, each of which must be zero within its own error (lambda = 0, or an estimate of
+    1/2 or more). Any other zero root stays a neutral mode."""
+    s = len(model.meta.get("steady", {}))
+    if not s or len(spec) == 0:
+        return spec
+    from dataclasses import replace
+
+    lam = np.abs(spec.growth + 1j * spec.frequencies)
+    zero = (lam == 0) | ~(spec.error_estimate < 0.5)
+    mark = np.zeros(lam.shape, bool)
+    rows = np.arange(len(lam))
+    order = np.argsort(np.where(np.isfinite(lam), lam, np.inf), axis=1)[:, :s]
+    for j in range(s):
+        mark[rows, order[:, j]] = zero[rows, order[:, j]]
+    return replace(spec, steady=mark)
 
 
 def with_modes(model: Model, params, spec: Spectrum) -> Spectrum:

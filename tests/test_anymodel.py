@@ -195,3 +195,43 @@ def test_modes_are_the_closed_forms_eigenvectors(rotor):
     assert doc["coordinates"] == ["x", "y", "alpha", "beta"] and len(doc["damping_ratio"]) == 4
     rc, out, err = run_cli("frequencies", str(ROTOR_FILE))
     assert "damping ratio" in out and "log. decr." in out
+
+
+def test_a_steady_coordinates_own_zero_root_does_not_make_a_decaying_system_marginal():
+    """The zero root a steadily turning coordinate owns (K e_c = 0 by construction) is marked,
+    shown for what it is, and leaves the verdict to the other roots; a second zero root is a
+    neutral mode all the same."""
+    from types import SimpleNamespace
+
+    from gyro.ladder import steady_roots
+    from gyro.results import Spectrum, classify
+
+    model = SimpleNamespace(name="spun", meta={"steady": {"phi": "Omega"}, "title": "t", "reduced": ["x", "phi"],
+                                               "equilibrium_coordinates": []})
+    f = np.array([[0.0, 250.0], [0.0, 0.0]])
+    g = np.array([[0.0, -12.0], [0.0, -3.0]])
+    e = np.array([[0.0, 1e-15], [1.0, 1.0]])
+    spec = steady_roots(model, Spectrum("default", f, g, e))
+    assert spec.steady.tolist() == [[True, False], [True, False]]
+    assert list(classify(spec).label) == ["stable", "marginal"]
+    assert "its own zero root" in spec.table(0, model) and "equilibrium: stable" in spec.table(0, model)
+    assert list(classify(Spectrum("default", f, g, e)).label) == ["marginal", "marginal"]  # unmarked
+
+
+def test_fuzz_leftovers():
+    """A sweep whose sets escalate to 40 digits stops at its budget in one line; 'unknown' at
+    the default method does not advise the default method; a zero answer for a root that is
+    not zero carries the bound 1."""
+    import gyro
+    from gyro.analyses.campbell import SweepBudget, batch_default
+
+    tg = gyro.load("torsion_gyrocompass")
+    P = np.tile(tg.vector(), (40, 1))
+    P[:, tg.param_names.index("A")] = np.geomspace(1e-300, 1e-200, 40)
+    with pytest.raises(SweepBudget, match="time budget"):
+        batch_default(tg, P, budget=0.2)
+    rc, out, err = run_cli("frequencies", "torsion_gyrocompass", "--set", "A=1e-300")
+    assert "unknown" in out and "try --method default" not in out
+    rc, out, err = run_cli("frequencies", "torsion_gyrocompass", "--set", "u=5e-324", "--json")
+    doc = json.loads(out)
+    assert doc["frequencies"][0] == 0.0 and doc["error_estimate"][0] >= 1.0

@@ -13,7 +13,7 @@ import numpy as np
 
 from gyro import ladder, qep
 from gyro.equilibrium import equilibria, operators
-from gyro.kernels import chunks, function
+from gyro.kernels import function
 from gyro.models import Model, ParameterError
 from gyro.results import CampbellDiagram, Spectrum
 from gyro.results.campbell import Crossing
@@ -22,10 +22,48 @@ CHUNK = 256  # parameter sets per call of the default method (the progress bar's
 MAX_CROSSING_STEPS = 60  # root finding of one crossing (bisection would need 52 for all digits)
 
 
-def batch_default(model: Model, P: np.ndarray, progress=False, desc="default") -> Spectrum:
-    """The default method over a large batch, in chunks, with a progress bar."""
-    return Spectrum.concat([ladder.spectrum(model, P[s], "default")
-                            for s in chunks(len(P), CHUNK, progress, desc)])
+BUDGET = 15.0  # s: a sweep stops past max(BUDGET, 20 x its cost at the default's nominal rate)
+
+
+class SweepBudget(RuntimeError):
+    """A sweep stopped at its time budget (sets that escalate to 40 digits cost ~1 s each)."""
+
+
+def batch_default(model: Model, P: np.ndarray, progress=False, desc="default", budget: float | None = BUDGET) -> Spectrum:
+    """The default method over a large batch, in chunks (4 sets first, growing to CHUNK),
+    with a progress bar; past its budget, max(budget, 20 x the batch's cost at the default
+    method's measured rate), it stops with SweepBudget (one line: how far it got)."""
+    import time
+
+    from gyro.methods import get
+
+    limit = None if budget is None else max(budget, 20 * len(P) * get("default").COST)
+    t0, parts, start, size = time.perf_counter(), [], 0, 4
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(P), desc=desc, unit="set", leave=False)
+    try:
+        while start < len(P):
+            if limit is not None and time.perf_counter() - t0 > limit:
+                raise SweepBudget(f"the sweep stopped at its time budget ({limit:.0f} s) after {start} of {len(P)} "
+                                  "sets: sets at extreme values escalate to 40-digit arithmetic (about 1 s "
+                                  "each); narrow the range")
+            stop = min(start + size, len(P))
+            parts.append(ladder.spectrum(model, P[start:stop], "default"))
+            if bar is not None:
+                bar.update(stop - start)
+            spent = time.perf_counter() - t0
+            per_set = spent / stop
+            # the next chunk as large as the budget left allows at the rate seen so far
+            room = size * 2 if limit is None else int((limit - spent) / max(2 * per_set, 1e-9))
+            slow = per_set > 0.01  # escalating sets (~1 s each, and uneven): one at a time
+            start, size = stop, 1 if slow else max(1, min(2 * size, CHUNK, room))
+    finally:
+        if bar is not None:
+            bar.close()
+    return Spectrum.concat(parts) if parts else ladder.spectrum(model, P, "default")
 
 
 def spin_parameter(model: Model, name: str | None) -> str:

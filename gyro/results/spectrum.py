@@ -22,6 +22,9 @@ class Spectrum:
     route: np.ndarray = field(default=None)  # per set: which rung answered (default only)
     growth_known: bool = True  # False for a method that computes no growth rates (formulas)
     modes: np.ndarray | None = None  # (sets, modes, coordinates) complex right eigenvectors, on request
+    # (sets, modes) bool: the zero root of a steadily turning coordinate (its phase is free by
+    # construction: no force depends on it), which says nothing of the motion's stability
+    steady: np.ndarray | None = None
 
     def damping_ratio(self) -> np.ndarray:
         """zeta = -Re(lambda)/|lambda| per root (0 for an undamped one, NaN at lambda = 0)."""
@@ -36,8 +39,14 @@ class Spectrum:
 
     @property
     def damped(self) -> bool:
-        """Any root with a growth rate that is not zero (the text table then shows damping)."""
-        return bool(self.growth_known and np.any(np.abs(np.nan_to_num(self.growth)) > 0))
+        """Any root whose growth rate is resolved from zero (beyond its error bound times
+        |lambda|, and 1e-9 |lambda|): the text table then shows the damping."""
+        if not self.growth_known:
+            return False
+        lam = np.abs(self.growth + 1j * self.frequencies)
+        est = np.where(np.isfinite(self.error_estimate), self.error_estimate, np.inf)
+        with np.errstate(all="ignore"):
+            return bool(np.any(np.abs(self.growth) > np.maximum(est, 1e-9) * lam))
 
     def __len__(self) -> int:
         return self.frequencies.shape[0]
@@ -46,7 +55,7 @@ class Spectrum:
     def concat(cls, parts: list["Spectrum"]) -> "Spectrum":
         """One spectrum of the sets of several, in order."""
         cat = {f: (None if getattr(parts[0], f) is None else np.concatenate([getattr(x, f) for x in parts]))
-               for f in ("frequencies", "growth", "error_estimate", "equilibrium", "route", "modes")}
+               for f in ("frequencies", "growth", "error_estimate", "equilibrium", "route", "modes", "steady")}
         return cls(parts[0].method, **cat, growth_known=all(p.growth_known for p in parts))
 
     def to_dict(self, k: int, model, params: dict) -> dict:
@@ -62,6 +71,7 @@ class Spectrum:
             "eigenvalues_re": [float(g) for g in self.growth[k]],
             "method": self.method,
             "error_estimate": [float(e) if np.isfinite(e) else None for e in self.error_estimate[k]],
+            **({"steady_roots": [int(j) for j in np.flatnonzero(self.steady[k])]} if self.steady is not None else {}),
             "stability": {"class": str(stab.label[k]), "growth_rate": float(stab.growth_rate[k]),
                           "unstable_roots": int(stab.unstable_roots[k])},
         } | (self.modes_dict(k, model) if self.modes is not None else {})
@@ -93,12 +103,17 @@ class Spectrum:
                 row += f" {zeta[i - 1]:>14.6g} {delta[i - 1]:>11.5g}"
             if grows[i - 1]:
                 row += f"   grows at {self.growth[k][i - 1]:.6g} 1/s"
+            if self.steady is not None and self.steady[k, i - 1]:
+                row += f"   the steady {', '.join(model.meta.get('steady', {}))}: its own zero root (a free phase)"
             lines.append(row)
         label = stab.label[k]
         note = {"unstable": f", {stab.unstable_roots[k]} growing root(s), the fastest at {stab.growth_rate[k]:.6g} 1/s",
                 "unknown": (f" (the method '{self.method}' computes no growth rates: no verdict; try --method "
                             "default)" if not self.growth_known else
-                            " (a root's error is unbounded: this method cannot tell; try --method default)"),
+                            " (a root's error is unbounded: this method cannot tell; try --method default)"
+                            if self.method != "default" else
+                            " (a root's error is unbounded at these parameters: no rung of the default method, "
+                            "up to 40 digits, bounds it; no verdict)"),
                 "failed": " (these parameters could not be computed)"}.get(label, "")
         lines.append(f"equilibrium: {label}{note}")
         return "\n".join(lines)
@@ -160,6 +175,8 @@ def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
     resolved = bounded & (est < 0.5)
     growing = (spec.growth > allow) & resolved
     neutral = bounded & ~resolved | (lam == 0)
+    if spec.steady is not None:  # a steady coordinate's own zero root is no neutral mode of the motion
+        neutral &= ~spec.steady
     failed = ~np.all(np.isfinite(spec.frequencies) & np.isfinite(spec.growth), axis=1)
     unknown = ~np.all(bounded, axis=1)
     if not spec.growth_known:  # the formulas assume a stable gyrocompass: no growth rates

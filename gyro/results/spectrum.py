@@ -88,18 +88,21 @@ class Spectrum:
         """The `gyro frequencies` text of set k."""
         freqs, est = self.frequencies[k], self.error_estimate[k]
         stab = classify(self)
+        # damping columns for a model with forces (its operator has a dissipative part) whose
+        # roots have growth rates resolved from zero; a conservative model's growth is instability
+        damped = self.damped and "operator_parts" in model.meta["functions"]
         lines = [f"{model.meta['title']} ({model.name})",
                  f"natural frequencies by the method '{self.method}'"
                  + (f" (answered by its {self.route[k]} rung)" if self.route is not None else "") + ":",
                  f"{'':>4} {'omega [rad/s]':>16} {'f [Hz]':>14} {'period [s]':>14} {'rel. error <=':>14}"
-                 + (f" {'damping ratio':>14} {'log. decr.':>11}" if self.damped else "")]
+                 + (f" {'damping ratio':>14} {'log. decr.':>11}" if damped else "")]
         zeta, delta = self.damping_ratio()[k], self.log_dec()[k]
         lam = np.abs(self.growth[k] + 1j * freqs)
         grows = (self.growth[k] > np.maximum(np.where(np.isfinite(est), est, np.inf), 1e-9) * lam) & np.isfinite(est)
         for i, (w, e) in enumerate(zip(freqs, est), 1):
             period = 2 * np.pi / w if w > 0 else float("inf")
             row = f"{i:>4} {w:>16.9g} {w / (2 * np.pi):>14.6g} {period:>14.6g} {e:>14.2g}"
-            if self.damped:
+            if damped:
                 row += f" {zeta[i - 1]:>14.6g} {delta[i - 1]:>11.5g}"
             if grows[i - 1]:
                 row += f"   grows at {self.growth[k][i - 1]:.6g} 1/s"

@@ -21,7 +21,7 @@ TIERS = {
     "paper": ("test_paper", "test_anchors", "test_nonlinear", "test_gimbal", "test_gimbal_closed_form",
               "test_gimbal_section6", "test_gimbal_paper_items", "test_paper_items",
               "test_gyrohorizoncompass"),
-    "methods": ("test_ladder", "test_anymodel"),
+    "methods": ("test_ladder", "test_anymodel", "test_harmonic"),
     "properties": ("test_properties",),
     "cli": ("test_cli", "test_gimbal_simulate", "test_readme", "test_sweep", "test_wheel", "test_ghc_cli", "test_fuzz", "test_robustness"),
 }

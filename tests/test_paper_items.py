@@ -50,9 +50,9 @@ def test_2_4_right_hand_side_is_the_input_matrix():
     other code path, 11 coordinates) has the same Jacobian in F on these rows. The argument
     omega_c t: the spin rate at the relative equilibrium is H/C less the Earth rate on the
     spin axis, within u/omega_c = 3e-8 of omega_c = H/C."""
-    v = MODEL.defaults
-    P = MODEL.vector(v)
     h = 0.003
+    v = MODEL.parameters({"h": h})
+    P = MODEL.vector(v)
     qe = equilibrium(MODEL, P)
     scale = {"x1": v["m"], "x3": v["m"], "x2": v["m"], "gamma1": v["A"], "gamma2": v["A"],
              "alpha": v["A"], "beta": v["A"]}
@@ -61,7 +61,7 @@ def test_2_4_right_hand_side_is_the_input_matrix():
     printed = {"x1": f1 / v["m"], "x3": f3 / v["m"], "x2": f2 / v["m"],
                "gamma1": h * f1 / v["A"], "gamma2": -h * f3 / v["A"]}
     for q0 in (qe, np.zeros_like(qe)):
-        B = np.asarray(MODEL.numpy.input_matrix(P, q0, [h]))
+        B = np.asarray(MODEL.numpy.input_matrix(P, q0))
         assert B.shape == (10, 3)
         Bw = B @ w
         for i, c in enumerate(RED):
@@ -73,12 +73,12 @@ def test_2_4_right_hand_side_is_the_input_matrix():
         q[coords.index(name)] = x
     qd = np.zeros(len(coords))
     qd[coords.index("gamma3")] = v["H"] / v["C"]
-    f0 = np.asarray(MODEL.numpy.forcing(P, q, qd, np.zeros(3), np.zeros(3), [h]))
-    B = np.asarray(MODEL.numpy.input_matrix(P, qe, [h]))
+    f0 = np.asarray(MODEL.numpy.forcing(P, q, qd, np.zeros(3), np.zeros(3)))
+    B = np.asarray(MODEL.numpy.input_matrix(P, qe))
     for s in range(3):
         e = np.zeros(3)
         e[s] = 1.0
-        col = np.asarray(MODEL.numpy.forcing(P, q, qd, e, np.zeros(3), [h])) - f0
+        col = np.asarray(MODEL.numpy.forcing(P, q, qd, e, np.zeros(3))) - f0
         for i, c in enumerate(RED):
             assert col[coords.index(c)] == pytest.approx(B[i, s], rel=1e-12, abs=1e-12), (c, s)
     # omega_c = H/C: (2.3) at rest gives gamma3' = H/C - u2 - u3 (beta0 + gamma20)

@@ -39,15 +39,25 @@ PARAMETERS = [
     Parameter("u", "rad/s", 7.29e-5, "Earth rotation rate", kind="nonnegative"),
     Parameter("phi", "deg", 60.0, "latitude", kind="real", bounds=(-90.0, 90.0)),
     Parameter("g", "m/s^2", 9.81, "gravity along the plumb line", kind="nonnegative"),
+    # (1.10): the lever of the imperfection forces on gamma1, gamma2. Two radial bearings of
+    # stiffness Kp/2 at +-h give the angular stiffness Kgamma = Kp h^2, so the example's
+    # h = sqrt(Kgamma/Kp) = 12.4 mm (docs/forced.md); it enters the forcing B only
+    Parameter("h", "m", (_A * 560.0**2 / (_m * 780.0**2)) ** 0.5,
+              "bearing size (1.10): lever of the imperfection forces on gamma1, gamma2"),
+    # optional bearing damping (Rayleigh function per bearing direction, docs/forced.md); the
+    # paper's model is conservative, so 0 by default and every printed number stays as it is
+    Parameter("cp", "N s/m", 0.0, "radial bearing damping (x1, x3)", kind="nonnegative"),
+    Parameter("c0", "N s/m", 0.0, "axial bearing damping (x2)", kind="nonnegative"),
+    Parameter("cgamma", "N m s/rad", 0.0, "angular bearing damping (gamma1, gamma2)", kind="nonnegative"),
 ]
 P = {p.name: p.symbol for p in PARAMETERS}
-m, M, l, l1, l2, A, C, I1, I2, I3, K0, Kp, Kgamma, H, u, phi, g = (P[p.name] for p in PARAMETERS)
+m, M, l, l1, l2, A, C, I1, I2, I3, K0, Kp, Kgamma, H, u, phi, g, h, cp, c0, cgamma = (P[p.name] for p in PARAMETERS)
+DAMPING = (cp, c0, cgamma)
 phi_rad = phi * sp.pi / 180
 u2, u3 = u * sp.cos(phi_rad), u * sp.sin(phi_rad)  # (1.3)
 
 # Symbols that the model uses before they are eliminated (shown symbolically to leave it).
 R1, j, nu = sp.symbols("R1 j nu")
-h = sp.Symbol("h")  # bearing length in (1.10); enters the forcing only
 
 # ----------------------------------------------------------------------------- coordinates
 # (1.1): sigma = {x1, x2, x3, gamma1, gamma2, gamma3, alpha, beta, gamma, lambda, mu}
@@ -110,6 +120,13 @@ def bearing_force_function():
     return (x1 * F1 + x2 * F2 + x3 * F3 + h * gamma1 * F1 - h * gamma2 * F3
             - sp.Rational(1, 2) * (Kp * x1**2 + K0 * x2**2 + Kp * x3**2
                                    + Kgamma * gamma1**2 + Kgamma * gamma2**2))
+
+
+def bearing_dissipation():
+    """Rayleigh function of the bearings, per direction: radial (x1, x3), axial (x2) and
+    angular (gamma1, gamma2) rates relative to the casing; Q_k = -dF/dqd_k. Not in the
+    paper (its model is conservative); zero at the default damping."""
+    return sp.Rational(1, 2) * (cp * (x1d**2 + x3d**2) + c0 * x2d**2 + cgamma * (gamma1d**2 + gamma2d**2))
 
 
 def lagrangian_with_plumb_line():
@@ -184,8 +201,9 @@ _u2s, _u3s = sp.symbols("u2 u3")
 
 
 def paper_approximation(expr):
-    """Apply approximations 2-4 above to one entry of M, D or K taken at q = 0."""
-    e = sp.expand(expr.subs({u2: _u2s, u3: _u3s}))
+    """Apply approximations 2-4 above to one entry of M, D or K taken at q = 0 (the paper's
+    model has no bearing damping)."""
+    e = sp.expand(expr.subs({u2: _u2s, u3: _u3s}).subs({c: 0 for c in DAMPING}))
     e = e.subs(_u3s, 0)
     e0 = e.subs(_u2s, 0)
     e1 = sp.diff(e, _u2s).subs(_u2s, 0).subs({A: 0, I1: 0, I2: 0, I3: 0})
@@ -510,7 +528,7 @@ def build():
         given_functions=given,
         given_values=list(sp.symbols("F1 F2 F3")),
         given_derivatives=list(sp.symbols("dF1 dF2 dF3")),
-        given_constants=[h],
+        dissipation=bearing_dissipation(),
         cyclic={CYCLIC: H},
         spin={"parameter": "H", "rate": H / C},  # (2.3)-(2.4): the spin rate omega_c = H/C
         reduced=REDUCED,

@@ -12,8 +12,9 @@ def functions(d) -> list[Function]:
     params = ("params", model.symbols)
     timed = ([("time", [TIME])] if d.time_dependent else []) + (
         [("signals", model.signal_symbols)] if model.signals else [])
-    given = [("given", model.given_values), ("dgiven", model.given_derivatives),
-             ("constants", model.given_constants)] if model.given_values else []
+    given = [("given", model.given_values), ("dgiven", model.given_derivatives)] if model.given_values else []
+    if model.given_values and model.given_constants:
+        given.append(("constants", model.given_constants))
     extra = []
     if model.has_forces:
         extra.append("generalised forces included")

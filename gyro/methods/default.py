@@ -45,7 +45,10 @@ def solve(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
     good = ok & tame(M) & tame(D) & tame(K)
     # which rung answered; "none" where no rung could (no equilibrium in any precision)
     route = np.where(good, "structured", "none").astype(object)
-    herm, w0 = qep.block_starts(model, M, D, K, good)
+    # the structured path assumes a conservative gyroscopic operator (D skew); a set with
+    # dissipation (D + D^T != 0, bearing damping) takes the general rung, which has growth
+    conservative = np.all(D == -np.swapaxes(D, -1, -2), axis=(-2, -1))
+    herm, w0 = qep.block_starts(model, M, D, K, good & conservative)
     h = np.flatnonzero(herm)
     if h.size:
         take = slice(None) if h.size == N else h

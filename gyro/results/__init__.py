@@ -10,6 +10,8 @@ One module per kind of result; every name is importable from `gyro.results`.
 - `sweep`: `FrequencySweep` (frequencies against any one parameter);
 - `trajectory`: `Trajectory` (the gimbal's motion: closed form or an integrator);
 - `gyrohorizoncompass`: `EquilibriumStability`, `ConditionMap`, `AngleTrajectory`;
+- `harmonic`: `HarmonicResponse` (steady response to harmonic inputs, a Bode curve, an
+  unbalance response), `ForcedResponse` (the bearing imperfections' harmonics, kept apart);
 - `_io`: atomic saving of arrays and figures, shared by all.
 """
 from __future__ import annotations
@@ -17,6 +19,7 @@ from __future__ import annotations
 from gyro.results._io import TMP_TAG, save_figure
 from gyro.results.campbell import FORMULA_BAD, CampbellDiagram
 from gyro.results.gyrohorizoncompass import AngleTrajectory, ConditionMap, EquilibriumStability
+from gyro.results.harmonic import ForcedResponse, HarmonicResponse
 from gyro.results.spectrum import ModalResult, Spectrum, Stability, classify, nearest_error
 from gyro.results.stability_map import StabilityMap
 from gyro.results.sweep import FrequencySweep
@@ -24,4 +27,4 @@ from gyro.results.trajectory import Trajectory
 
 __all__ = ["TMP_TAG", "save_figure", "FORMULA_BAD", "CampbellDiagram", "AngleTrajectory", "ConditionMap",
            "EquilibriumStability", "ModalResult", "Spectrum", "Stability", "classify", "nearest_error",
-           "StabilityMap", "FrequencySweep", "Trajectory"]
+           "StabilityMap", "FrequencySweep", "Trajectory", "HarmonicResponse", "ForcedResponse"]

@@ -33,7 +33,7 @@ class SweepBudget(RuntimeError):
 
 def batch_default(model: Model, P: np.ndarray, progress=False, desc="default", budget: float | None = BUDGET,
                   watch: float = WATCH) -> Spectrum:
-    """The default method over a large batch, in chunks (4 sets first, growing to CHUNK; one
+    """The default method over a large batch, in chunks (1 set first, growing to CHUNK; one
     at a time once sets cost over 10 ms, as escalating ones do), with a progress bar. Once
     `watch` seconds have passed, a sweep whose projected time (the rate so far times the
     sets) exceeds max(budget, 20 x the batch's cost at the default method's measured rate)
@@ -44,7 +44,7 @@ def batch_default(model: Model, P: np.ndarray, progress=False, desc="default", b
     from gyro.methods import get
 
     limit = None if budget is None else max(budget, 20 * len(P) * get("default").COST)
-    t0, first, parts, start, size = time.perf_counter(), 0, [], 0, 4
+    t0, first, warm, parts, start, size = time.perf_counter(), 0, 0.0, [], 0, 1
     bar = None
     if progress:
         from tqdm import tqdm
@@ -57,14 +57,15 @@ def batch_default(model: Model, P: np.ndarray, progress=False, desc="default", b
             if bar is not None:
                 bar.update(stop - start)
             if not parts[:-1]:  # the first chunk carries one-off costs (compiling the C): the clock starts after it
+                warm = time.perf_counter() - t0
                 t0, first = time.perf_counter(), stop
             spent = time.perf_counter() - t0
-            per_set = spent / max(stop - first, 1)
-            if limit is not None and stop < len(P) and spent > watch and per_set * len(P) > limit:
+            per_set = spent / (stop - first) if stop > first else warm / stop
+            if limit is not None and stop < len(P) and stop > first and spent > watch and per_set * len(P) > limit:
                 raise SweepBudget(f"the sweep would take about {per_set * len(P):.0f} s ({per_set:.2g} s a set "
                                   f"after {stop} of {len(P)}): sets at extreme values escalate to 40-digit "
                                   "arithmetic; narrow the range or use fewer points")
-            slow = stop > first and per_set > 0.01  # escalating sets (~1 s each, and uneven): one at a time
+            slow = per_set > 0.01  # escalating sets (~1 s each, and uneven): one at a time
             start, size = stop, 1 if slow else min(2 * size, CHUNK)
     finally:
         if bar is not None:

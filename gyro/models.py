@@ -139,15 +139,14 @@ def load(name: str | Path) -> Model:
     from gyro.catalog import model_source
 
     text = str(name)
+    if not isinstance(name, Path) and text in _CACHE:  # by name: the model loaded under it (the
+        return _CACHE[text]                            # compiled backend's look-up, once per call)
     kind = model_source(text)
     if kind == "builtin" and not isinstance(name, Path):
-        if text not in _CACHE or _CACHE[text].directory != GENERATED / text:
-            _CACHE[text] = Model(text)
+        _CACHE[text] = Model(text)
         return _CACHE[text]
     if kind is None:
         if not isinstance(name, Path) and "/" not in text and "\\" not in text and not text.endswith(".py"):
-            if text in _CACHE:  # loaded from a path earlier in this session
-                return _CACHE[text]
             raise ParameterError(f"unknown model {text!r}; known: {', '.join(available())}, "
                                  "or a model file PATH.py, or an emitted folder DIR/<name>")
         if Path(text).expanduser().exists():

@@ -34,7 +34,7 @@ class SweepBudget(RuntimeError):
 def batch_default(model: Model, P: np.ndarray, progress=False, desc="default", budget: float | None = BUDGET,
                   watch: float = WATCH) -> Spectrum:
     """The default method over a large batch, in chunks (1 set first, growing to CHUNK; one
-    at a time once sets cost over 10 ms, as escalating ones do), with a progress bar. Once
+    at a time once sets cost over 0.25 s, as escalating ones do), with a progress bar. Once
     `watch` seconds have passed, a sweep whose projected time (the rate so far times the
     sets) exceeds max(budget, 20 x the batch's cost at the default method's measured rate)
     stops with SweepBudget, one line saying how far it got: a range over 300 decades stops
@@ -65,7 +65,7 @@ def batch_default(model: Model, P: np.ndarray, progress=False, desc="default", b
                 raise SweepBudget(f"the sweep would take about {per_set * len(P):.0f} s ({per_set:.2g} s a set "
                                   f"after {stop} of {len(P)}): sets at extreme values escalate to 40-digit "
                                   "arithmetic; narrow the range or use fewer points")
-            slow = per_set > 0.01  # escalating sets (~1 s each, and uneven): one at a time
+            slow = per_set > 0.25  # sets escalating to 40 digits (~1 s each, and uneven): one at a time
             start, size = stop, 1 if slow else min(2 * size, CHUNK)
     finally:
         if bar is not None:

@@ -39,14 +39,22 @@ class Spectrum:
 
     @property
     def damped(self) -> bool:
-        """Any root whose growth rate is resolved from zero (beyond its error bound times
-        |lambda|, and 1e-9 |lambda|): the text table then shows the damping."""
+        """Any root that decays, resolved from zero (beyond its error bound times |lambda|, and
+        1e-9 |lambda|), other than the mirror of a growing one: the text table then shows the
+        damping."""
         if not self.growth_known:
             return False
-        lam = np.abs(self.growth + 1j * self.frequencies)
+        f, g = self.frequencies, self.growth
+        lam = np.abs(g + 1j * f)
         est = np.where(np.isfinite(self.error_estimate), self.error_estimate, np.inf)
         with np.errstate(all="ignore"):
-            return bool(np.any(np.abs(self.growth) > np.maximum(est, 1e-9) * lam))
+            allow = np.maximum(est, 1e-9) * lam
+            decays, grows = g < -allow, g > allow
+            # a decaying root mirroring a growing one (sigma -> -sigma at the same frequency: a
+            # conservative flutter quadruple) is no damping
+            mirror = np.any(grows[:, None, :] & (np.abs(f[:, :, None] - f[:, None, :]) <= 1e-6 * lam[:, :, None])
+                            & (np.abs(g[:, :, None] + g[:, None, :]) <= 1e-6 * lam[:, :, None]), axis=2)
+            return bool(np.any(decays & ~mirror))
 
     def __len__(self) -> int:
         return self.frequencies.shape[0]
@@ -88,9 +96,7 @@ class Spectrum:
         """The `gyro frequencies` text of set k."""
         freqs, est = self.frequencies[k], self.error_estimate[k]
         stab = classify(self)
-        # damping columns for a model with forces (its operator has a dissipative part) whose
-        # roots have growth rates resolved from zero; a conservative model's growth is instability
-        damped = self.damped and "operator_parts" in model.meta["functions"]
+        damped = self.damped  # a decaying root: the damping ratio and log. decrement shown
         lines = [f"{model.meta['title']} ({model.name})",
                  f"natural frequencies by the method '{self.method}'"
                  + (f" (answered by its {self.route[k]} rung)" if self.route is not None else "") + ":",

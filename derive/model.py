@@ -223,6 +223,11 @@ class Model:
     # the model's hierarchy: Level declarations (docs/hierarchy.md), cheapest to most exact
     # or in any order (the runtime orders them by cost)
     levels: list = field(default_factory=list)
+    # the spin, for Campbell diagrams and harmonic lines (derive/outputs/spin.py):
+    # {"parameter": name of the parameter that sets it, "rate": the spin rate in rad/s as an
+    # expression of the parameters (default: the parameter itself), "whirl": [(a, b), ...]
+    # pairs of reduced coordinates whose orbit a -> b turns with the spin (forward whirl)}
+    spin: dict = field(default_factory=dict)
 
     @property
     def signal_symbols(self) -> list:

@@ -44,3 +44,25 @@ def module_constants(folder, wanted: tuple) -> dict:
                     consts[node.targets[0].id] = node.value.value
         out[m.name] = consts
     return out
+def cache_dir() -> Path:
+    """The runtime's cache: compiled libraries, and models derived from files ($GYRO_CACHE,
+    default ~/.cache/gyro-dynamics)."""
+    import os
+
+    return Path(os.environ.get("GYRO_CACHE", Path.home() / ".cache" / "gyro-dynamics"))
+
+
+def model_source(text: str) -> str | None:
+    """What a MODEL argument names: 'builtin' (a generated model's name), 'emitted' (a folder
+    DIR/<name> with its metadata.json), 'file' (a model file PATH.py, or a model folder with
+    an __init__.py, derived on first use), or None (nothing of these)."""
+    if "/" not in text and "\\" not in text and not text.endswith(".py") and text in available():
+        return "builtin"
+    path = Path(text).expanduser()
+    if path.is_dir():
+        if (path / "metadata.json").is_file():
+            return "emitted"
+        return "file" if (path / "__init__.py").is_file() else None
+    if path.is_file() and path.suffix == ".py":
+        return "file"
+    return None

@@ -63,7 +63,9 @@ def _built(cls, model_name, *args):
 
 
 def cache_dir() -> Path:
-    return Path(os.environ.get("GYRO_CACHE", Path.home() / ".cache" / "gyro-dynamics"))
+    from gyro.catalog import cache_dir as shared
+
+    return shared()
 
 
 def library(model_name: str) -> ctypes.CDLL:

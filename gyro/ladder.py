@@ -37,9 +37,13 @@ def as_batch(model: Model, params) -> np.ndarray:
     return P
 
 
-def spectrum(model: Model, params, method: str = "default", tol: float = DEFAULT_TOL) -> Spectrum:
+def spectrum(model: Model, params, method: str = "default", tol: float = DEFAULT_TOL,
+             modes: bool = False) -> Spectrum:
     """Natural frequencies of a batch of parameter sets (rows of `params`, in the order of
-    model.param_names) by one method of the ladder."""
+    model.param_names) by one method of the ladder; with `modes`, the right eigenvectors
+    too (Spectrum.modes: with_modes)."""
+    if modes:
+        return with_modes(model, params, spectrum(model, params, method, tol))
     if method not in METHODS:
         raise ValueError(f"method: unknown {method!r}; known: {', '.join(METHODS)}")
     P = as_batch(model, params)
@@ -48,7 +52,43 @@ def spectrum(model: Model, params, method: str = "default", tol: float = DEFAULT
         empty = np.zeros((0, n))
         return Spectrum(method, empty, empty.copy(), empty.copy(),
                         np.zeros((0, len(model.meta["equilibrium_coordinates"]))), np.zeros(0, object))
-    return get(method).solve(model, P, tol)
+    return steady_roots(model, get(method).solve(model, P, tol))
+
+
+def steady_roots(model: Model, spec: Spectrum) -> Spectrum:
+    """Mark the zero roots that steadily turning coordinates own (Spectrum.steady). Such a
+    coordinate is absent from L and the forces (the derivation proves it), so K e_c = 0 and
+    lambda = 0 is a root of each, exactly: per set, the len(steady) roots of smallest
+    |lambda|, each of which must be zero within its own error (lambda = 0, or an estimate of
+    1/2 or more). Any other zero root stays a neutral mode."""
+    s = len(model.meta.get("steady", {}))
+    if not s or len(spec) == 0:
+        return spec
+    from dataclasses import replace
+
+    lam = np.abs(spec.growth + 1j * spec.frequencies)
+    zero = (lam == 0) | ~(spec.error_estimate < 0.5)
+    mark = np.zeros(lam.shape, bool)
+    rows = np.arange(len(lam))
+    order = np.argsort(np.where(np.isfinite(lam), lam, np.inf), axis=1)[:, :s]
+    for j in range(s):
+        mark[rows, order[:, j]] = zero[rows, order[:, j]]
+    return replace(spec, steady=mark)
+
+
+def with_modes(model: Model, params, spec: Spectrum) -> Spectrum:
+    """The spectrum with its mode shapes: for each root lambda = growth + i omega, the right
+    eigenvector of J(lambda) about the set's equilibrium (gyro.qep.eigenvectors), over the
+    reduced coordinates in their own units."""
+    from dataclasses import replace
+
+    from gyro import qep
+    from gyro.equilibrium import equilibria, operators
+
+    P = as_batch(model, params)
+    qe = spec.equilibrium if spec.equilibrium is not None else equilibria(model, P)[0]
+    M, D, K = operators(model, P, qe)
+    return replace(spec, modes=qep.eigenvectors(M, D, K, spec.growth + 1j * spec.frequencies))
 
 
 def natural_frequencies(model: Model, values: dict, method: str = "default") -> ModalResult:

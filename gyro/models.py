@@ -130,16 +130,112 @@ _CACHE: dict[str, Model] = {}
 
 
 def load(name: str | Path) -> Model:
-    """A generated model by name (generated/<name>), or by the folder it was emitted into
-    (a path: DIR/<name> from `python -m derive --model PATH.py --out DIR`); the compiled
-    backend then finds it by its name."""
-    if isinstance(name, Path) or "/" in str(name) or "\\" in str(name):
-        directory = Path(name).resolve()
-        model_name = directory.name
-        known = _CACHE.get(model_name)
-        if known is None or known.directory != directory:
-            _CACHE[model_name] = Model(model_name, directory)
-        return _CACHE[model_name]
-    if name not in _CACHE:
-        _CACHE[name] = Model(name)
-    return _CACHE[name]
+    """A model by what names it (gyro.catalog.model_source): a generated model's name
+    (generated/<name>); the folder it was emitted into (DIR/<name> from `python -m derive
+    --model PATH.py --out DIR`); or a model file PATH.py (or a model folder), derived on
+    first use into the cache by the hash of its inputs (derived_folder). A model loaded
+    from a path is known by its name for the rest of the session; the compiled backend
+    finds it by that name."""
+    from gyro.catalog import model_source
+
+    text = str(name)
+    if not isinstance(name, Path) and text in _CACHE:  # by name: the model loaded under it (the
+        return _CACHE[text]                            # compiled backend's look-up, once per call)
+    kind = model_source(text)
+    if kind == "builtin" and not isinstance(name, Path):
+        _CACHE[text] = Model(text)
+        return _CACHE[text]
+    if kind is None:
+        if not isinstance(name, Path) and "/" not in text and "\\" not in text and not text.endswith(".py"):
+            raise ParameterError(f"unknown model {text!r}; known: {', '.join(available())}, "
+                                 "or a model file PATH.py, or an emitted folder DIR/<name>")
+        if Path(text).expanduser().exists():
+            raise ParameterError(f"{text}: not a model (neither a model file *.py, nor a folder with "
+                                 "a metadata.json or an __init__.py)")
+        raise ParameterError(f"{text}: no such model file or folder")
+    directory = (derived_folder(Path(text).expanduser()) if kind == "file"
+                 else Path(text).expanduser().resolve())
+    model_name = directory.name
+    known = _CACHE.get(model_name)
+    if known is None or known.directory != directory:
+        _CACHE[model_name] = Model(model_name, directory)
+    return _CACHE[model_name]
+
+
+def _source_root() -> Path | None:
+    """The source checkout this runtime runs from (it has derive/ beside gyro/), or None
+    (an installed wheel carries no derive/)."""
+    root = Path(__file__).resolve().parent.parent
+    return root if (root / "derive" / "__main__.py").is_file() and (root / "templates").is_dir() else None
+
+
+def model_key(path: Path, root: Path) -> str:
+    """The hash of everything a derivation of the model file `path` reads: the file (or the
+    model folder's Python files) and the Python files beside it (a model file may import
+    them), the machinery (derive/, templates/) and the versions of SymPy and SymEngine."""
+    import hashlib
+    from importlib.metadata import PackageNotFoundError, version
+
+    h = hashlib.sha256()
+    path = path.resolve()
+    own = sorted(path.glob("*.py")) if path.is_dir() else [path] + sorted(
+        p for p in path.parent.glob("*.py") if p != path)
+    machinery = sorted(p for p in (root / "derive").rglob("*.py") if "__pycache__" not in p.parts)
+    machinery += sorted(p for p in (root / "templates").iterdir() if p.is_file())
+    for p in own + machinery:
+        h.update(str(p.relative_to(root) if p.is_relative_to(root) else p).encode() + b"\0")
+        h.update(p.read_bytes() + b"\0")
+    for dist in ("sympy", "symengine"):
+        try:
+            h.update(f"{dist}={version(dist)}".encode())
+        except PackageNotFoundError:
+            pass
+    return h.hexdigest()[:20]
+
+
+def derived_folder(path: Path) -> Path:
+    """The emitted folder of a model file, derived on first use by `python -m derive --model`
+    (in a subprocess: the runtime imports no SymPy) into <cache>/models/<key>/<name>, where
+    key = model_key; said in one line on stderr. A file that is not a model, or that the
+    machinery refuses, is a ParameterError carrying derive's one line; without SymPy or
+    without the build-time side, one line naming what to install."""
+    import importlib.util
+    import os
+    import shutil
+    import subprocess
+    import sys
+
+    from gyro.catalog import cache_dir
+
+    root = _source_root()
+    if root is None:
+        raise ParameterError(f"{path}: deriving a model file needs the build-time side (derive/, "
+                             "in a source checkout of gyro-dynamics installed with its [derive] extra)")
+    if importlib.util.find_spec("sympy") is None or importlib.util.find_spec("symengine") is None:
+        raise ParameterError(f"{path}: deriving a model file needs SymPy: install the [derive] extra "
+                             "(pip install -e '.[derive]')")
+    home = cache_dir() / "models"
+    done = home / model_key(path, root)
+    found = [d for d in done.iterdir() if (d / "metadata.json").is_file()] if done.is_dir() else []
+    if len(found) == 1:
+        return found[0]
+    home.mkdir(parents=True, exist_ok=True)
+    tmp = home / f"{done.name}.tmp-{os.getpid()}"
+    shutil.rmtree(tmp, ignore_errors=True)
+    print(f"gyro: deriving the model file {path} (first use; cached in {done}) ...", file=sys.stderr, flush=True)
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(root)] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
+    proc = subprocess.run([sys.executable, "-m", "derive", "--model", str(path.resolve()), "--out", str(tmp)],
+                          cwd=root, env=env, capture_output=True, text=True)
+    if proc.returncode != 0:
+        shutil.rmtree(tmp, ignore_errors=True)
+        lines = [ln for ln in proc.stderr.strip().splitlines() if ln.strip()]
+        last = lines[-1] if lines else f"exit status {proc.returncode}"
+        if proc.returncode == 2:
+            raise ParameterError(last.removeprefix("derive: "))
+        raise RuntimeError(f"deriving {path} failed: {last}")
+    made = [d for d in tmp.iterdir() if (d / "metadata.json").is_file()]
+    try:
+        os.replace(tmp, done)  # atomic: a concurrent run that finished first keeps its copy
+    except OSError:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return done / made[0].name

@@ -131,7 +131,7 @@ def test_found_in_review_cli(tmp_path):
              "--y-range", "0.1", "1", "--points", "2", "--out", str(tmp_path / "m.png"), "--quiet")
     assert r.returncode == 0, r.stderr
     r = gyro("campbell", "gyrohorizoncompass", "--out", str(tmp_path / "c.png"))
-    assert r.returncode == 2 and "no rotor momentum H" in r.stderr
+    assert r.returncode == 2 and "declares no spin parameter" in r.stderr
     r = gyro("sweep", "torsion_gyrocompass", "--x", "H", "--x-range", "1", "1e12", "--x-log", "--points", "3", "--json")
     doc = json.loads(r.stdout)
     assert r.returncode == 1 and None in doc["frequencies"][-1] and "no finite spectrum" in r.stderr

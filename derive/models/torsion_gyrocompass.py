@@ -577,6 +577,7 @@ def build():
         given_derivatives=list(sp.symbols("dF1 dF2 dF3")),
         dissipation=bearing_dissipation(),
         cyclic={CYCLIC: H},
+        spin={"parameter": "H", "rate": H / C},  # (2.3)-(2.4): the spin rate omega_c = H/C
         reduced=REDUCED,
         symmetric_zero=ODD,
         equilibrium_approx=equilibrium_approx(),

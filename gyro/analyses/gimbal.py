@@ -550,7 +550,8 @@ def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, at
         import casadi as ca
 
         y, ydot = _casadi_ode(P)
-        opts = {"abstol": atol, "reltol": rtol, "max_num_steps": budget_steps}
+        opts = {"abstol": atol, "reltol": rtol, "max_num_steps": budget_steps,
+                "disable_internal_warnings": True}  # SUNDIALS' own lines on stderr: the error says it
         F = ca.integrator("F", method, {"x": y, "ode": ydot}, t[0], t, opts)
         try:
             Y = np.array(F(x0=y0)["xf"]).T

@@ -2,7 +2,7 @@
 `run(args)`, found here without a list (ORDER sets the help's order).
 
     gyro frequencies MODEL [--set NAME=VALUE]... [--method NAME] [--json]
-    gyro campbell MODEL [--set NAME=VALUE]... --out FILE.png [--range LO HI] [--points N]
+    gyro campbell MODEL [--spin NAME] [--spin-range LO HI] [--points N] [--harmonics K1,K2,...] [--set ...] [--json] [--out FILE.png]
     gyro stability-map MODEL --x NAME --x-range LO HI --y NAME --y-range LO HI [--x-log] [--y-log] --out FILE.png
     gyro params MODEL
     gyro simulate gimbal_gyroscope [--set NAME=VALUE]... --t-end T [--points N] [--method NAME] [--json] [--out FILE.png]
@@ -14,7 +14,8 @@
     gyro unbalance MODEL --force-x NAME --force-y NAME --magnitude ME [--phase PHI] [--spin NAME] --spin-range LO HI [--points N] [--set ...] [--json] [--out FILE.png]
     gyro scene MODEL QUESTION --tol REL [--set NAME=VALUE]... [--modes I,J,...] [--horizon T] [--json]
 
-Bad input prints one line on stderr naming the parameter and exits with code 2; a
+MODEL is a generated model's name, an emitted folder DIR/<name>, or a model file PATH.py
+(derived on first use). Bad input prints one line on stderr naming the parameter and exits with code 2; a
 numerical failure at valid input one line and exit 1.
 """
 from __future__ import annotations

@@ -30,16 +30,22 @@ class Parser(argparse.ArgumentParser):
 
 def add_model(p, models=None, help="the model (gyro params MODEL lists its parameters)") -> None:
     """The positional MODEL, its choices the generated models (or `models`)."""
-    from gyro.catalog import available
+    from gyro.catalog import available, model_source
 
     known = list(models or available())
 
     def model_name(text: str) -> str:
-        if text not in known:
-            raise argparse.ArgumentTypeError(f"unknown model {text!r}; known: {', '.join(known)}")
-        return text
+        if text in known:
+            return text
+        if models is None:  # any model: a generated one, an emitted folder or a model file
+            if model_source(text) is not None:
+                return text
+            raise argparse.ArgumentTypeError(f"unknown model {text!r}: not one of {', '.join(known)}, nor a "
+                                             "model file PATH.py, nor an emitted folder DIR/<name>")
+        raise argparse.ArgumentTypeError(f"unknown model {text!r}; known: {', '.join(known)}")
 
-    p.add_argument("model", type=model_name, metavar="MODEL", help=f"{help}; one of: {', '.join(known)}")
+    more = ", or a model file PATH.py (derived on first use), or an emitted folder DIR/<name>" if models is None else ""
+    p.add_argument("model", type=model_name, metavar="MODEL", help=f"{help}; one of: {', '.join(known)}{more}")
 
 
 def add_set(p, help: str | None = SET_HELP) -> None:

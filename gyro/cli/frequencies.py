@@ -20,6 +20,8 @@ def register(sub) -> None:
     f.add_argument("--sensitivities", action="store_true",
                    help="also d omega / d p of every frequency to every parameter (exact, with the "
                         "equilibrium's own dependence), and relative: (p / omega) d omega / d p")
+    f.add_argument("--modes", action="store_true",
+                   help="with --json: damping ratio, logarithmic decrement and the mode shapes (right eigenvectors)")
     f.set_defaults(run=run)
 
 
@@ -32,7 +34,9 @@ def run(args) -> int:
     values = model.parameters(parse_sets(args.set))
     if args.method == "formulas" and "mode_formulas" not in model.meta["functions"]:
         raise ParameterError(f"--method formulas: {model.name} has no approximate formulas")
-    spec = ladder.spectrum(model, model.vector(values), args.method)
+    if args.modes and args.method == "formulas":
+        raise ParameterError("--modes: the formulas give frequencies only; use another --method")
+    spec = ladder.spectrum(model, model.vector(values), args.method, modes=args.modes)
     if not (np.all(np.isfinite(spec.frequencies[0])) and np.all(np.isfinite(spec.growth[0]))):
         raise FloatingPointError("a frequency is not finite")  # no verdict: exit 1, text and JSON alike
     sens = None

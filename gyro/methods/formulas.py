@@ -25,7 +25,11 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None) -> Spectrum:
     """The model's mode formulas (metadata 'mode_formulas') over the batch: for each mode,
     among its candidate formulas the one whose own error estimate is smallest, sorted by
     frequency. Compiled: one pass of the generated C (templates/mode_select.c.j2); without a
-    compiler, NumPy."""
+    compiler, NumPy. A model without formulas is refused in one line (ParameterError)."""
+    if not available(model):
+        from gyro.errors import ParameterError
+
+        raise ParameterError(f"method formulas: {model.name} has no approximate formulas; try --method default")
     kernel = compiled(cbackend.mode_formulas_selected, model)
     if kernel is not None:
         with np.errstate(all="ignore"):

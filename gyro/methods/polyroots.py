@@ -32,7 +32,12 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None) -> Spectrum:
         p = np.sqrt(s.astype(complex))
         J = (M[:, None] * s[..., None, None] + D[:, None] * p[..., None, None] + K[:, None])
         dets = np.linalg.det(J).real  # J(i w) is Hermitian: det is real
-    for k in np.flatnonzero(ok & np.all(np.isfinite(dets), axis=1)):
+    # a damped or circulatory operator (D not skew, K or M not symmetric beyond rounding):
+    # det J(i w) is complex and not a polynomial in p^2; those sets take the full fit in p
+    general = ok & ~conservative(M, D, K)
+    for k in np.flatnonzero(general):
+        freq[k], growth[k], est[k] = _general_fit(M[k], D[k], K[k], R[k])
+    for k in np.flatnonzero(ok & ~general & np.all(np.isfinite(dets), axis=1)):
         # in x = -1 - 2 s / R the nodes are t; the power basis in s follows by substitution
         x_of_s = np.polynomial.polynomial.Polynomial([-1.0, -2.0 / R[k]])
 
@@ -58,3 +63,50 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None) -> Spectrum:
         est[k] = np.where(e < 0.5, e, np.inf)  # a first-order bound past 1/2 bounds nothing
     f, g, e = qep.sort_spectrum(freq, growth, est)
     return Spectrum("polyroots", f, g, e, qe)
+
+
+def conservative(M, D, K, rel: float = 16 * qep.EPS) -> np.ndarray:
+    """Per set: M, K symmetric and D skew to rounding (rel of each matrix's largest entry)."""
+    def off(X, sign):
+        scale = np.max(np.abs(X), axis=(1, 2))
+        return np.max(np.abs(X - sign * np.swapaxes(X, 1, 2)), axis=(1, 2)) <= rel * scale
+
+    with np.errstate(all="ignore"):
+        return off(M, 1) & off(K, 1) & off(D, -1)
+
+
+def _general_fit(M, D, K, R):
+    """det J(p), a polynomial of degree 2n in p, fitted from 2n + 1 Chebyshev points p = i Y t
+    (t in [-1, 1], Y = sqrt(R) bounds the frequencies), complex; roots in x = p/(i Y) by
+    numpy.roots. The estimate carries the fit's rounding (eps max|det| per Chebyshev
+    coefficient, through the conversion to the power basis) into each root to first order,
+    as for the conservative fit; past 1/2 it bounds nothing (inf)."""
+    n = M.shape[-1]
+    nan = (np.full(n, np.nan), np.full(n, np.nan), np.full(n, np.inf))
+    Y = np.sqrt(R)
+    if not (np.isfinite(Y) and Y > 0):
+        return nan
+    t = np.cos(np.pi * (np.arange(2 * n + 1) + 0.5) / (2 * n + 1))
+    p = 1j * Y * t
+    with np.errstate(all="ignore"):
+        dets = np.linalg.det(M * (p**2)[:, None, None] + D * p[:, None, None] + K)
+    if not np.all(np.isfinite(dets)):
+        return nan
+    cheb = np.polynomial.chebyshev.chebfit(t, dets, 2 * n)
+    c = np.polynomial.chebyshev.cheb2poly(cheb)
+    x = np.roots(c[::-1])
+    if len(x) != 2 * n:
+        return nan
+    lam = 1j * Y * x
+    conv = np.abs(np.array([np.pad(b := np.polynomial.chebyshev.cheb2poly(np.eye(2 * n + 1)[j]), (0, 2 * n + 1 - len(b)))
+                            for j in range(2 * n + 1)]))  # (cheb, power)
+    dc = qep.EPS * (2 * n + 1) * np.max(np.abs(dets)) * conv.sum(axis=0)
+    dx = np.polynomial.polynomial.polyval(np.abs(x), dc) / np.abs(
+        np.polynomial.polynomial.polyval(x, np.polynomial.polynomial.polyder(c)))
+    e = dx / np.maximum(np.abs(x), 1e-300)
+    e = np.where(e < 0.5, e, np.inf)
+    keep = np.isin(np.arange(2 * n), [int(np.argmin(np.abs(lam - r))) for r in qep.representatives(lam, n)])
+    lam, e = lam[keep], e[keep]
+    if len(lam) != n:
+        return nan
+    return np.abs(lam.imag), lam.real, e

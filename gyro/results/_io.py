@@ -42,8 +42,12 @@ def _load_npz(cls, path):
 
 
 def _jsonable(v):
+    if isinstance(v, np.ndarray) and np.iscomplexobj(v):
+        return {"re": v.real.tolist(), "im": v.imag.tolist()}
     if isinstance(v, np.ndarray):
         return v.tolist()
+    if isinstance(v, (list, tuple)):
+        return [_jsonable(x) for x in v]
     if isinstance(v, (np.floating, np.integer)):
         return v.item()
     if is_dataclass(v) and not isinstance(v, type):

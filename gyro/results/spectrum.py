@@ -22,6 +22,40 @@ class Spectrum:
     equilibrium: np.ndarray | None = None  # (sets, equilibrium coordinates)
     route: np.ndarray = field(default=None)  # per set: which rung answered (default only)
     growth_known: bool = True  # False for a method that computes no growth rates (formulas)
+    modes: np.ndarray | None = None  # (sets, modes, coordinates) complex right eigenvectors, on request
+    # (sets, modes) bool: the zero root of a steadily turning coordinate (its phase is free by
+    # construction: no force depends on it), which says nothing of the motion's stability
+    steady: np.ndarray | None = None
+
+    def damping_ratio(self) -> np.ndarray:
+        """zeta = -Re(lambda)/|lambda| per root (0 for an undamped one, NaN at lambda = 0)."""
+        with np.errstate(all="ignore"):
+            return -self.growth / np.abs(self.growth + 1j * self.frequencies)
+
+    def log_dec(self) -> np.ndarray:
+        """Logarithmic decrement delta = -2 pi Re(lambda)/Im(lambda) per root (the decay of
+        the amplitude over one damped period); NaN for a root that does not oscillate."""
+        with np.errstate(all="ignore"):
+            return np.where(self.frequencies > 0, -2 * np.pi * self.growth / self.frequencies, np.nan)
+
+    @property
+    def damped(self) -> bool:
+        """Any root that decays, resolved from zero (beyond its error bound times |lambda|, and
+        1e-9 |lambda|), other than the mirror of a growing one: the text table then shows the
+        damping."""
+        if not self.growth_known:
+            return False
+        f, g = self.frequencies, self.growth
+        lam = np.abs(g + 1j * f)
+        est = np.where(np.isfinite(self.error_estimate), self.error_estimate, np.inf)
+        with np.errstate(all="ignore"):
+            allow = np.maximum(est, 1e-9) * lam
+            decays, grows = g < -allow, g > allow
+            # a decaying root mirroring a growing one (sigma -> -sigma at the same frequency: a
+            # conservative flutter quadruple) is no damping
+            mirror = np.any(grows[:, None, :] & (np.abs(f[:, :, None] - f[:, None, :]) <= 1e-6 * lam[:, :, None])
+                            & (np.abs(g[:, :, None] + g[:, None, :]) <= 1e-6 * lam[:, :, None]), axis=2)
+            return bool(np.any(decays & ~mirror))
 
     def __len__(self) -> int:
         return self.frequencies.shape[0]
@@ -30,7 +64,7 @@ class Spectrum:
     def concat(cls, parts: list["Spectrum"]) -> "Spectrum":
         """One spectrum of the sets of several, in order."""
         cat = {f: (None if getattr(parts[0], f) is None else np.concatenate([getattr(x, f) for x in parts]))
-               for f in ("frequencies", "growth", "error_estimate", "equilibrium", "route")}
+               for f in ("frequencies", "growth", "error_estimate", "equilibrium", "route", "modes", "steady")}
         return cls(parts[0].method, **cat, growth_known=all(p.growth_known for p in parts))
 
     def to_dict(self, k: int, model, params: dict) -> dict:
@@ -46,32 +80,51 @@ class Spectrum:
             "eigenvalues_re": [float(g) for g in self.growth[k]],
             "method": self.method,
             "error_estimate": [float(e) if np.isfinite(e) else None for e in self.error_estimate[k]],
+            **({"steady_roots": [int(j) for j in np.flatnonzero(self.steady[k])]} if self.steady is not None else {}),
             "stability": {"class": str(stab.label[k]), "growth_rate": float(stab.growth_rate[k]),
                           "unstable_roots": int(stab.unstable_roots[k]),
                           "reason": None if stab.reason is None else stab.reason[k]},
-        }
+        } | (self.modes_dict(k, model) if self.modes is not None else {})
+
+    def modes_dict(self, k: int, model) -> dict:
+        """`gyro frequencies --modes`: damping ratio, logarithmic decrement and one right
+        eigenvector per frequency (coordinates in the `reduced` order, {re, im} lists)."""
+        num = lambda a: [float(x) if np.isfinite(x) else None for x in a]  # noqa: E731
+        return {"damping_ratio": num(self.damping_ratio()[k]), "log_dec": num(self.log_dec()[k]),
+                "coordinates": list(model.meta["reduced"]),
+                "modes": [{"re": num(v.real), "im": num(v.imag)} for v in self.modes[k]]}
 
     def table(self, k: int, model) -> str:
         """The `gyro frequencies` text of set k."""
         freqs, est = self.frequencies[k], self.error_estimate[k]
         stab = classify(self)
+        damped = self.damped  # a decaying root: the damping ratio and log. decrement shown
         lines = [f"{model.meta['title']} ({model.name})",
                  f"natural frequencies by the method '{self.method}'"
                  + (f" (answered by its {self.route[k]} rung)" if self.route is not None else "") + ":",
-                 f"{'':>4} {'omega [rad/s]':>16} {'f [Hz]':>14} {'period [s]':>14} {'rel. error <=':>14}"]
+                 f"{'':>4} {'omega [rad/s]':>16} {'f [Hz]':>14} {'period [s]':>14} {'rel. error <=':>14}"
+                 + (f" {'damping ratio':>14} {'log. decr.':>11}" if damped else "")]
+        zeta, delta = self.damping_ratio()[k], self.log_dec()[k]
         lam = np.abs(self.growth[k] + 1j * freqs)
         grows = (self.growth[k] > np.maximum(np.where(np.isfinite(est), est, np.inf), 1e-9) * lam) & np.isfinite(est)
         for i, (w, e) in enumerate(zip(freqs, est), 1):
             period = 2 * np.pi / w if w > 0 else float("inf")
             row = f"{i:>4} {w:>16.9g} {w / (2 * np.pi):>14.6g} {period:>14.6g} {e:>14.2g}"
+            if damped:
+                row += f" {zeta[i - 1]:>14.6g} {delta[i - 1]:>11.5g}"
             if grows[i - 1]:
                 row += f"   grows at {self.growth[k][i - 1]:.6g} 1/s"
+            if self.steady is not None and self.steady[k, i - 1]:
+                row += f"   the steady {', '.join(model.meta.get('steady', {}))}: its own zero root (a free phase)"
             lines.append(row)
         label = stab.label[k]
         note = {"unstable": f", {stab.unstable_roots[k]} growing root(s), the fastest at {stab.growth_rate[k]:.6g} 1/s",
                 "unknown": (f" (the method '{self.method}' computes no growth rates: no verdict; try --method "
                             "default)" if not self.growth_known else
-                            " (a root's error is unbounded: this method cannot tell; try --method default)"),
+                            " (a root's error is unbounded: this method cannot tell; try --method default)"
+                            if self.method != "default" else
+                            " (a root's error is unbounded at these parameters: no rung of the default method, "
+                            "up to 40 digits, bounds it; no verdict)"),
                 "failed": " (these parameters could not be computed)",
                 "boundary": f" (rounding could change the verdict: {stab.reason[k]})"}.get(label, "")
         lines.append(f"equilibrium: {label}{note}")
@@ -137,6 +190,8 @@ def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
     resolved = bounded & (est < 0.5)
     growing = (spec.growth > allow) & resolved
     neutral = bounded & ~resolved | (lam == 0)
+    if spec.steady is not None:  # a steady coordinate's own zero root is no neutral mode of the motion
+        neutral &= ~spec.steady
     failed = ~np.all(np.isfinite(spec.frequencies) & np.isfinite(spec.growth), axis=1)
     unknown = ~np.all(bounded, axis=1)
     if not spec.growth_known:  # the formulas assume a stable gyrocompass: no growth rates

@@ -1,0 +1,53 @@
+"""The spin a model declares (Model.spin): which parameter sets it, the spin rate in rad/s
+as an expression of the parameters (emitted as `spin_rate`, so that the runtime never
+retypes it: the torsion gyrocompass's omega_c = H/C of (2.4)), and the coordinate pairs
+whose orbit tells forward from backward whirl."""
+from __future__ import annotations
+
+import sympy as sp
+
+from derive.model import Function, Unsupported
+
+ORDER = 65
+
+
+def _declared(d):
+    spin = d.model.spin
+    if not spin:
+        return None
+    model = d.model
+    unknown = set(spin) - {"parameter", "rate", "whirl"}
+    if unknown:
+        raise Unsupported(f"{model.name}: spin: unknown keys {sorted(unknown)}; known: parameter, rate, whirl")
+    name = spin.get("parameter")
+    if name not in [p.name for p in model.parameters]:
+        raise Unsupported(f"{model.name}: spin: parameter {name!r} is not a parameter of the model")
+    rate = sp.sympify(spin.get("rate", model.param(name).symbol))
+    bad = sorted(map(str, rate.free_symbols - set(model.symbols)))
+    if bad:
+        raise Unsupported(f"{model.name}: spin: the rate uses {', '.join(bad)}, not parameters")
+    if not rate.has(model.param(name).symbol):
+        raise Unsupported(f"{model.name}: spin: the rate {rate} does not depend on {name}")
+    pairs = [tuple(map(str, pr)) for pr in spin.get("whirl", [])]
+    for pr in pairs:
+        if len(pr) != 2 or any(c not in d.order for c in pr):
+            raise Unsupported(f"{model.name}: spin: whirl pair {pr} is not two reduced coordinates "
+                              f"({', '.join(d.order)})")
+    return name, rate, pairs
+
+
+def functions(d) -> list[Function]:
+    spin = _declared(d)
+    if spin is None:
+        return []
+    name, rate, _ = spin
+    return [Function("spin_rate", [("params", d.model.symbols)], [("rate", sp.Matrix([rate]))],
+                     f"The spin rate in rad/s set by the parameter {name}: {rate}.")]
+
+
+def metadata(d) -> dict:
+    spin = _declared(d)
+    if spin is None:
+        return {}
+    name, rate, pairs = spin
+    return {"spin": {"parameter": name, "rate": str(rate), "whirl": [list(p) for p in pairs]}}

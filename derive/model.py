@@ -228,6 +228,10 @@ class Model:
     # expression of the parameters (default: the parameter itself), "whirl": [(a, b), ...]
     # pairs of reduced coordinates whose orbit a -> b turns with the spin (forward whirl)}
     spin: dict = field(default_factory=dict)
+    # names a user types for parameters whose symbol the emitted code cannot carry (the
+    # paper's lambda is `lam`, M_motor `Mmotor`): {name typed: parameter's name}; every
+    # command and the API take either (gyro.models.Model.parameters)
+    aliases: dict = field(default_factory=dict)
 
     @property
     def signal_symbols(self) -> list:

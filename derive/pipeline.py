@@ -452,6 +452,11 @@ def metadata(d: Derivation) -> dict:
     }
     if d.constraints:
         meta["constraints"] = d.constraints
+    if model.aliases:
+        unknown = sorted(set(model.aliases.values()) - {p.name for p in model.parameters})
+        if unknown:
+            raise Unsupported(f"aliases name no parameter: {', '.join(unknown)}")
+        meta["aliases"] = dict(model.aliases)
     for kind in outputs.kinds():
         meta.update(getattr(kind, "metadata", lambda _: {})(d))
     return meta

@@ -83,11 +83,17 @@ class Model:
     def defaults(self) -> dict[str, float]:
         return {p.name: p.default for p in self.params}
 
+    def canonical(self, name: str) -> str:
+        """A parameter's own name for a name a user typed (its alias, as the paper's lambda for
+        the symbol lam), or the name itself."""
+        return self.meta.get("aliases", {}).get(name, name)
+
     def parameters(self, overrides: dict | None = None) -> dict[str, float]:
         """Every parameter's value: the paper example's, replaced by `overrides`; validated."""
         values = self.defaults
         by_name = {p.name: p for p in self.params}
         for key, raw in (overrides or {}).items():
+            key = self.canonical(key)  # a name typed for a symbol the code cannot carry
             if key not in by_name:
                 raise ParameterError(f"unknown parameter {key!r} for {self.name}; known: {' '.join(self.param_names)}")
             try:

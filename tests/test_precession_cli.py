@@ -133,3 +133,18 @@ def test_scene_picks_the_cheapest_adequate_theory():
     assert rc == 0, err
     d = json.loads(out)
     assert d["level"] == "small" and d["tried"][0]["level"] == "elementary"  # (28) keeps the imbalance
+
+
+def test_a_parameter_typed_by_its_alias_is_the_same_parameter():
+    """M_motor (the symbol Mmotor: names M_* are refused by the emitters) and the paper's
+    lambda (the symbol lam) are taken by every command through Model.parameters; an alias
+    naming no parameter would be refused at derive time."""
+    from gyro.models import load
+
+    for name, alias, symbol, value in (("gimbal_precession", "M_motor", "Mmotor", 0.25),
+                                       ("gyrohorizoncompass", "lambda", "lam", 1.5)):
+        model = load(name)
+        assert model.meta["aliases"][alias] == symbol and symbol in model.param_names
+        assert model.canonical(alias) == symbol and model.canonical(symbol) == symbol
+        assert model.parameters({alias: value})[symbol] == value
+        assert model.vector({alias: value})[model.param_names.index(symbol)] == value

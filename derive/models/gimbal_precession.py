@@ -386,4 +386,5 @@ def build():
         identities={"kinematics (3)-(5) are the frames' angular velocities": kinematics_are_the_papers},
         quantities=quantities(),
         levels=levels(),
+        aliases=CLI_NAMES,
     )

@@ -377,4 +377,5 @@ def build():
         },
         quantities=quantities(),
         levels=levels(),
+        aliases=CLI_NAMES,
     )

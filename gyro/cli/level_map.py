@@ -42,7 +42,9 @@ def run(args) -> int:
 
     model = load(args.model)
     question_of(model, args.level, args.against, args.question)
-    xaxis, yaxis = parse_axis("--x", args.x, model.param_names), parse_axis("--y", args.y, model.param_names)
+    names = model.param_names + list(model.meta.get("aliases", {}))
+    xaxis, yaxis = ((model.canonical(a[0]),) + a[1:] for a in (parse_axis(f, t, names) for f, t in
+                                                              (("--x", args.x), ("--y", args.y))))
     t_end = finite_number("--t-end", args.t_end)
     if not t_end > 0:
         raise ParameterError(f"--t-end must be positive, got {args.t_end!r}")
@@ -50,7 +52,7 @@ def run(args) -> int:
     if not 0 < tol < 1:
         raise ParameterError(f"--tol must lie in (0, 1), got {args.tol!r}")
     out = check_png_out(args.out)
-    sets = {k: finite_number(f"parameter {k}", v) for k, v in parse_sets(args.set).items()}
+    sets = {model.canonical(k): finite_number(f"parameter {k}", v) for k, v in parse_sets(args.set).items()}
     model.parameters(sets)  # every name and value checked before anything runs
     grid = level_map(model, args.level, args.against, xaxis, yaxis, sets, tol, args.question,
                      {"horizon": t_end}, progress=not args.quiet and sys.stderr.isatty())

@@ -55,7 +55,7 @@ def run(args) -> int:
     tol = _tol(args.tol)
     model = load(args.model)
     q = questions.get(args.question)
-    sets = parse_sets(args.set)
+    sets = {model.canonical(k): v for k, v in parse_sets(args.set).items()}
     # a question's own inputs beside the model's parameters (the motion's initial conditions)
     extra = q.initial_conditions(model) if hasattr(q, "initial_conditions") else {}
     for key in sets:

@@ -49,7 +49,7 @@ def test_samples_have_the_spreads_and_correlations_asked():
     chol = np.linalg.cholesky(corr)
     nominal = np.array([2.0, 3.0, 5.0])
     P = samples(nominal, np.arange(3), np.array([0.1, 0.2, 0.3]), np.array([False, True, True]), chol, 1, 0,
-                100_000, chunk=100_000)
+                100_000)
     dev = P / nominal - 1
     # 1e5 samples: standard errors of 0.3 % on a std and 0.003 on a correlation; bounds of four
     assert abs(dev[:, 0].std() / 0.1 - 1) < 0.012

@@ -5,9 +5,9 @@ A spread is relative to the parameter's nominal value: normal with standard devi
 SIGMA, or uniform within +-HALFWIDTH; spreads may be correlated (a Gaussian copula: the
 correlated standard normals z = L e, L the Cholesky factor of the correlation matrix; a
 uniform parameter takes Phi(z)). Sampling runs over the sweep executor (gyro.executor) in
-chunks of CHUNK samples; the samples of chunk c come from the generator seeded with
-(seed, c), so that a chunk is a pure function of its inputs and any executor gives the
-same bits. The frequencies are the default method's (the model hierarchy's selector of
+chunks of CHUNK samples; the samples come in blocks of STREAM, block b from the
+generator seeded with (seed, b), whatever the chunks: a chunk is a pure function of its
+inputs, and any executor and any chunk size give the same samples and the same bits. The frequencies are the default method's (the model hierarchy's selector of
 the cheapest adequate level is not in this tree yet). A sample outside a parameter's
 valid range, or without an answer, is counted in `failed`, never dropped silently.
 
@@ -33,7 +33,8 @@ from gyro.errors import ParameterError
 from gyro.models import Model, load
 from gyro.results import ToleranceStudy
 
-CHUNK = 4096  # samples per chunk: the unit of work, of retry and of the random streams
+CHUNK = 4096  # samples per chunk: the unit of work and of retry
+STREAM = 4096  # samples per random stream: block b of the study draws from (seed, b)
 QUANTILES = (0.01, 0.5, 0.99)
 BINS = 60
 IN_MEMORY = 1 << 28  # bytes: larger results go to .npy memory maps on disk
@@ -103,12 +104,16 @@ def spin_rate(model: Model, P: np.ndarray) -> np.ndarray | None:
     return P[:, model.param_names.index("H")] / P[:, model.param_names.index("C")]
 
 
-def samples(nominal, index, relwidth, uniform, chol, seed, start, stop, chunk=CHUNK):
-    """The parameter sets start..stop of the study (start a multiple of `chunk`)."""
+def samples(nominal, index, relwidth, uniform, chol, seed, start, stop):
+    """The parameter sets start..stop of the study: the rows start..stop of the blocks of
+    STREAM draws, block b from the generator seeded with (seed, b), so that they do not
+    depend on how the study is cut into chunks."""
     from scipy.special import ndtr
 
-    rng = np.random.default_rng([seed, start // chunk])
-    z = rng.standard_normal((chunk, len(index)))[: stop - start] @ chol.T
+    first, last = start // STREAM, max(stop - 1, start) // STREAM
+    e = np.concatenate([np.random.default_rng([seed, b]).standard_normal((STREAM, len(index)))
+                        for b in range(first, last + 1)])
+    z = e[start - first * STREAM: stop - first * STREAM] @ chol.T
     dev = np.where(uniform, 2 * ndtr(z) - 1, z) * relwidth
     P = np.tile(nominal, (stop - start, 1))
     P[:, index] *= 1 + dev
@@ -132,10 +137,10 @@ def valid(model: Model, P: np.ndarray) -> np.ndarray:
     return ok
 
 
-def chunk(start, stop, model_ref, nominal, index, relwidth, uniform, chol, seed, size=CHUNK):
+def chunk(start, stop, model_ref, nominal, index, relwidth, uniform, chol, seed):
     """One chunk of the study: the samples' frequencies (NaN where failed) and spin rates."""
     model = load(model_ref)
-    P = samples(nominal, index, relwidth, uniform, chol, seed, start, stop, size)
+    P = samples(nominal, index, relwidth, uniform, chol, seed, start, stop)
     ok = valid(model, P)
     n = len(model.meta["reduced"])
     freq = np.full((stop - start, n), np.nan)
@@ -152,8 +157,8 @@ def chunk(start, stop, model_ref, nominal, index, relwidth, uniform, chol, seed,
 def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: int = 0,
               pairs: dict | None = None, scheduler=None, harmonics=(), band: float = 0.02,
               store: Path | None = None, progress: bool = False, size: int = CHUNK) -> ToleranceStudy:
-    """The study over n samples; `size` samples a chunk (with the seed, it fixes the
-    samples: chunk c draws from the generator seeded with (seed, c))."""
+    """The study over n samples, `size` samples a chunk (the samples and the answer do not
+    depend on it: the random streams come in blocks of STREAM)."""
     from gyro.analyses.sensitivity import sensitivities
 
     names = [s.name for s in spreads]
@@ -187,7 +192,7 @@ def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: i
         folder = Path(tmp.name)
     try:
         ref = model_ref(model)
-        out = executor.run(chunk, n, size, (ref, nominal, index, relwidth, uniform, chol, seed, size), scheduler,
+        out = executor.run(chunk, n, size, (ref, nominal, index, relwidth, uniform, chol, seed), scheduler,
                            folder, progress, "tolerance", warm=warm, warm_args=(ref,))
         F = out["frequencies"]
         ok = np.all(np.isfinite(F), axis=1)

@@ -76,6 +76,37 @@ def test_band_probability(study):
         assert row[0]["probability"] == 0 and row[0]["first_order_probability"] < 1e-12
 
 
+def test_band_probability_at_a_band_edge(tg):
+    """A spread of C alone moves no frequency (the operator has H, not C) but the spin rate
+    omega_c = H/C: with a band of 55 % the lower edge 0.45 omega_c = 1131 lies 1.5 % above
+    omega9 = 1114, so omega9 is inside when C > 0.45 H / omega9, a probability known in
+    closed form, 1 - Phi(z*), z* = (0.45 H / (omega9 C0) - 1) / sigma (about 0.068); the
+    sampled one lies within four binomial standard errors of it (0.0016 for N = 4096), and
+    the first-order one is the lower edge linearised, omega9 - 0.45 omega_c normal with the
+    std 0.45 omega_c sigma: Phi((omega9 / (0.45 omega_c) - 1) / sigma), to rounding. With
+    the edge's std taken as omega_c sigma (the factor 0.45 lost) it would be 0.25."""
+    from scipy.special import ndtr
+
+    n, sigma, band = 4096, 0.01, 0.55
+    st = tolerance(tg, tg.defaults, [parse_spread(f"C=normal:{sigma}")], n, seed=5, harmonics=(1,), band=band)
+    H, C0 = tg.defaults["H"], tg.defaults["C"]
+    w9, wc = st.nominal[8], H / C0
+    got = st.band_probability[8][0]
+    assert got["omega"] == wc
+    exact = 1 - ndtr(((1 - band) * H / (w9 * C0) - 1) / sigma)
+    assert abs(got["probability"] - exact) <= 4 * np.sqrt(exact * (1 - exact) / n), (got, exact)
+    assert abs(got["first_order_probability"] - ndtr((w9 / ((1 - band) * wc) - 1) / sigma)) < 1e-12, got
+
+
+def test_a_frequency_the_spreads_do_not_move(tg):
+    """omega_p = sqrt(Kp/m) under a spread of H: its samples differ by rounding only (a
+    histogram of them needs a range of its own), and its spreads are nil to rounding."""
+    st = tolerance(tg, tg.defaults, [parse_spread("H=normal:0.01")], 256, seed=1)
+    i = int(np.argmin(np.abs(st.nominal - 780)))
+    assert st.failed == 0 and st.std[i] < 1e-9 * st.nominal[i] and st.first_order_std[i] < 1e-9 * st.nominal[i]
+    assert np.all(np.diff(st.edges[i]) > 0) and st.counts[i].sum() == 256
+
+
 def test_cli_contract(tg, tmp_path):
     out = tmp_path / "h.png"
     rc, text, err = run_cli("tolerance", MODEL, "--spread", "Kp=normal:0.05", "--spread", "Kgamma=uniform:0.1",

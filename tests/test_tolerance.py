@@ -107,6 +107,18 @@ def test_a_frequency_the_spreads_do_not_move(tg):
     assert np.all(np.diff(st.edges[i]) > 0) and st.counts[i].sum() == 256
 
 
+def test_a_mode_without_sensitivities_has_no_first_order(tg):
+    """At u = 0 the azimuth is free: omega1 = 0 is a double root (with its mirror), so it has
+    no sensitivities, and neither a first-order std nor a first-order band probability: null
+    in the JSON and said in the table, never a number (a point mass would give 0 or 1)."""
+    st = tolerance(tg, {**tg.defaults, "u": 0.0}, [parse_spread("Kp=normal:0.01")], 64, seed=1, harmonics=(1,))
+    doc = json.loads(json.dumps(st.to_dict(), allow_nan=False))
+    assert doc["frequencies"][0]["first_order_std"] is None and doc["frequencies"][0]["first_order_holds"] is None
+    assert doc["band_probability"][0][0]["first_order_probability"] is None
+    assert doc["band_probability"][8][0]["first_order_probability"] is not None
+    assert "none (a double root at the nominal set)" in st.table().splitlines()[3]
+
+
 def test_cli_contract(tg, tmp_path):
     out = tmp_path / "h.png"
     rc, text, err = run_cli("tolerance", MODEL, "--spread", "Kp=normal:0.05", "--spread", "Kgamma=uniform:0.1",

@@ -271,7 +271,8 @@ def _bands(F, ok, spin, harmonics, band, nominal_freq, dfreq, model, nominal, co
                 g = dfreq[i][index] - e * k * dwc[index]
                 s = float(np.sqrt(g @ cov @ g))
                 mu = nominal_freq[i] - e * k * wc0
-                fo += sign * (float(ndtr(mu / s)) if s > 0 else float(mu > 0))
+                # no sensitivities (a double root at the nominal set): no first order, NaN
+                fo += sign * (float(ndtr(mu / s)) if s > 0 else float(mu > 0) if s == 0 else np.nan)
             row.append({"harmonic": k, "omega": k * wc0, "probability": int(inside.sum()) / n_ok,
                         "first_order_probability": fo})
         out.append(row)

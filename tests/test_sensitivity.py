@@ -217,3 +217,11 @@ def test_the_emitted_jacobians_numpy_and_c(tg, nominal):
                   - np.concatenate([np.ravel(X) for X in tg.numpy.operator(Pm, qe)])) / (Pp[j] - Pm[j])
             assert np.all(np.abs(dJ[:, j] - fd) * abs(P[j]) <= 1e-8 * rows_scale), j
         assert dJ.shape[1] == npar + len(qe)
+
+
+def test_a_method_without_error_bounds_gives_no_derivative(tg):
+    """polyroots cannot bound some of its roots' errors: the distance of every root to those
+    is unknown, so no root gets a derivative, and the table says why (not 'double')."""
+    s = sensitivities(tg, tg.vector(), method="polyroots")
+    assert not np.all(np.isfinite(s.spectrum.error_estimate)) and np.all(np.isnan(s.d))
+    assert all("unbounded" in line for line in s.table(0).splitlines()[1:])

@@ -137,6 +137,7 @@ def test_cli_contract(tg, tmp_path):
                       (["--spread", "Kp=normal:-1"], "--spread Kp"), (["--spread", "Kp=normal:0.05", "--samples", "0"], "--samples"),
                       (["--spread", "Kp=normal:0.05", "--correlate", "Kp,K0=0.5"], "K0"),
                       (["--spread", "Kp=normal:0.05", "--harmonics", "0"], "--harmonics"),
+                      (["--spread", "Kp=normal:0.05", "--harmonics", "1", "--set", "H=0"], "--harmonics"),
                       (["--spread", "Kp=normal:0.05", "--out", str(tmp_path / "x.jpg")], "--out")):
         args = ["tolerance", MODEL, *bad] + ([] if "--samples" in bad else ["--samples", "10"])
         rc, text, err = run_cli(*args)

@@ -171,6 +171,8 @@ def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: i
         raise ParameterError("--spread: a parameter is given twice")
     if harmonics and spin_rate(model, model.vector(values)[None]) is None:
         raise ParameterError(f"--harmonics: {model.name} has no spin rate H/C (parameters H and C)")
+    if harmonics and not spin_rate(model, model.vector(values)[None])[0] > 0:
+        raise ParameterError("--harmonics: the rotor does not spin (H = 0): no harmonic k omega_c to fall on")
     corr = correlation(spreads, pairs or {})
     chol = np.linalg.cholesky(corr)
     nominal = model.vector(values)

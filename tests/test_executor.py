@@ -38,8 +38,9 @@ def batch():
 
 def test_dask_gives_the_bits_of_the_in_process_run(cluster, batch):
     tg, P = batch
+    # other chunks on Dask: a set's answer is its own, whatever chunk it is computed in
     here = spectra(tg, P, chunk=64)
-    there = spectra(tg, P, scheduler=cluster, chunk=64)
+    there = spectra(tg, P, scheduler=cluster, chunk=37)
     for f in ("frequencies", "growth", "error_estimate", "equilibrium"):
         assert np.array_equal(getattr(here, f), getattr(there, f), equal_nan=True), f
     assert list(here.route) == list(there.route)
@@ -76,6 +77,8 @@ def test_results_go_to_memory_maps_chunk_by_chunk(tmp_path, batch):
 def test_a_tolerance_study_on_dask_is_the_in_process_one(cluster):
     tg = load(MODEL)
     spreads = [parse_spread("Kp=normal:0.05"), parse_spread("Kgamma=uniform:0.1")]
+    # other chunks on Dask: the random streams come in blocks of their own, so the samples
+    # (and every bit of the answer) do not depend on the chunks
     a = tolerance(tg, tg.defaults, spreads, 700, seed=3, size=256)
-    b = tolerance(tg, tg.defaults, spreads, 700, seed=3, scheduler=cluster, size=256)
+    b = tolerance(tg, tg.defaults, spreads, 700, seed=3, scheduler=cluster, size=100)
     assert a.to_dict() == b.to_dict()

@@ -49,7 +49,7 @@ def test_samples_have_the_spreads_and_correlations_asked():
     chol = np.linalg.cholesky(corr)
     nominal = np.array([2.0, 3.0, 5.0])
     P = samples(nominal, np.arange(3), np.array([0.1, 0.2, 0.3]), np.array([False, True, True]), chol, 1, 0,
-                100_000, chunk=100_000)
+                100_000)
     dev = P / nominal - 1
     # 1e5 samples: standard errors of 0.3 % on a std and 0.003 on a correlation; bounds of four
     assert abs(dev[:, 0].std() / 0.1 - 1) < 0.012
@@ -76,6 +76,49 @@ def test_band_probability(study):
         assert row[0]["probability"] == 0 and row[0]["first_order_probability"] < 1e-12
 
 
+def test_band_probability_at_a_band_edge(tg):
+    """A spread of C alone moves no frequency (the operator has H, not C) but the spin rate
+    omega_c = H/C: with a band of 55 % the lower edge 0.45 omega_c = 1131 lies 1.5 % above
+    omega9 = 1114, so omega9 is inside when C > 0.45 H / omega9, a probability known in
+    closed form, 1 - Phi(z*), z* = (0.45 H / (omega9 C0) - 1) / sigma (about 0.068); the
+    sampled one lies within four binomial standard errors of it (0.0016 for N = 4096), and
+    the first-order one is the lower edge linearised, omega9 - 0.45 omega_c normal with the
+    std 0.45 omega_c sigma: Phi((omega9 / (0.45 omega_c) - 1) / sigma), to rounding. With
+    the edge's std taken as omega_c sigma (the factor 0.45 lost) it would be 0.25."""
+    from scipy.special import ndtr
+
+    n, sigma, band = 4096, 0.01, 0.55
+    st = tolerance(tg, tg.defaults, [parse_spread(f"C=normal:{sigma}")], n, seed=5, harmonics=(1,), band=band)
+    H, C0 = tg.defaults["H"], tg.defaults["C"]
+    w9, wc = st.nominal[8], H / C0
+    got = st.band_probability[8][0]
+    assert got["omega"] == wc
+    exact = 1 - ndtr(((1 - band) * H / (w9 * C0) - 1) / sigma)
+    assert abs(got["probability"] - exact) <= 4 * np.sqrt(exact * (1 - exact) / n), (got, exact)
+    assert abs(got["first_order_probability"] - ndtr((w9 / ((1 - band) * wc) - 1) / sigma)) < 1e-12, got
+
+
+def test_a_frequency_the_spreads_do_not_move(tg):
+    """omega_p = sqrt(Kp/m) under a spread of H: its samples differ by rounding only (a
+    histogram of them needs a range of its own), and its spreads are nil to rounding."""
+    st = tolerance(tg, tg.defaults, [parse_spread("H=normal:0.01")], 256, seed=1)
+    i = int(np.argmin(np.abs(st.nominal - 780)))
+    assert st.failed == 0 and st.std[i] < 1e-9 * st.nominal[i] and st.first_order_std[i] < 1e-9 * st.nominal[i]
+    assert np.all(np.diff(st.edges[i]) > 0) and st.counts[i].sum() == 256
+
+
+def test_a_mode_without_sensitivities_has_no_first_order(tg):
+    """At u = 0 the azimuth is free: omega1 = 0 is a double root (with its mirror), so it has
+    no sensitivities, and neither a first-order std nor a first-order band probability: null
+    in the JSON and said in the table, never a number (a point mass would give 0 or 1)."""
+    st = tolerance(tg, {**tg.defaults, "u": 0.0}, [parse_spread("Kp=normal:0.01")], 64, seed=1, harmonics=(1,))
+    doc = json.loads(json.dumps(st.to_dict(), allow_nan=False))
+    assert doc["frequencies"][0]["first_order_std"] is None and doc["frequencies"][0]["first_order_holds"] is None
+    assert doc["band_probability"][0][0]["first_order_probability"] is None
+    assert doc["band_probability"][8][0]["first_order_probability"] is not None
+    assert "none (a double root at the nominal set)" in st.table().splitlines()[3]
+
+
 def test_cli_contract(tg, tmp_path):
     out = tmp_path / "h.png"
     rc, text, err = run_cli("tolerance", MODEL, "--spread", "Kp=normal:0.05", "--spread", "Kgamma=uniform:0.1",
@@ -94,6 +137,7 @@ def test_cli_contract(tg, tmp_path):
                       (["--spread", "Kp=normal:-1"], "--spread Kp"), (["--spread", "Kp=normal:0.05", "--samples", "0"], "--samples"),
                       (["--spread", "Kp=normal:0.05", "--correlate", "Kp,K0=0.5"], "K0"),
                       (["--spread", "Kp=normal:0.05", "--harmonics", "0"], "--harmonics"),
+                      (["--spread", "Kp=normal:0.05", "--harmonics", "1", "--set", "H=0"], "--harmonics"),
                       (["--spread", "Kp=normal:0.05", "--out", str(tmp_path / "x.jpg")], "--out")):
         args = ["tolerance", MODEL, *bad] + ([] if "--samples" in bad else ["--samples", "10"])
         rc, text, err = run_cli(*args)

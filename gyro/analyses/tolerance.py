@@ -5,9 +5,9 @@ A spread is relative to the parameter's nominal value: normal with standard devi
 SIGMA, or uniform within +-HALFWIDTH; spreads may be correlated (a Gaussian copula: the
 correlated standard normals z = L e, L the Cholesky factor of the correlation matrix; a
 uniform parameter takes Phi(z)). Sampling runs over the sweep executor (gyro.executor) in
-chunks of CHUNK samples; the samples of chunk c come from the generator seeded with
-(seed, c), so that a chunk is a pure function of its inputs and any executor gives the
-same bits. The frequencies are the default method's (the model hierarchy's selector of
+chunks of CHUNK samples; the samples come in blocks of STREAM, block b from the
+generator seeded with (seed, b), whatever the chunks: a chunk is a pure function of its
+inputs, and any executor and any chunk size give the same samples and the same bits. The frequencies are the default method's (the model hierarchy's selector of
 the cheapest adequate level is not in this tree yet). A sample outside a parameter's
 valid range, or without an answer, is counted in `failed`, never dropped silently.
 
@@ -33,7 +33,8 @@ from gyro.errors import ParameterError
 from gyro.models import Model, load
 from gyro.results import ToleranceStudy
 
-CHUNK = 4096  # samples per chunk: the unit of work, of retry and of the random streams
+CHUNK = 4096  # samples per chunk: the unit of work and of retry
+STREAM = 4096  # samples per random stream: block b of the study draws from (seed, b)
 QUANTILES = (0.01, 0.5, 0.99)
 BINS = 60
 IN_MEMORY = 1 << 28  # bytes: larger results go to .npy memory maps on disk
@@ -103,12 +104,16 @@ def spin_rate(model: Model, P: np.ndarray) -> np.ndarray | None:
     return P[:, model.param_names.index("H")] / P[:, model.param_names.index("C")]
 
 
-def samples(nominal, index, relwidth, uniform, chol, seed, start, stop, chunk=CHUNK):
-    """The parameter sets start..stop of the study (start a multiple of `chunk`)."""
+def samples(nominal, index, relwidth, uniform, chol, seed, start, stop):
+    """The parameter sets start..stop of the study: the rows start..stop of the blocks of
+    STREAM draws, block b from the generator seeded with (seed, b), so that they do not
+    depend on how the study is cut into chunks."""
     from scipy.special import ndtr
 
-    rng = np.random.default_rng([seed, start // chunk])
-    z = rng.standard_normal((chunk, len(index)))[: stop - start] @ chol.T
+    first, last = start // STREAM, max(stop - 1, start) // STREAM
+    e = np.concatenate([np.random.default_rng([seed, b]).standard_normal((STREAM, len(index)))
+                        for b in range(first, last + 1)])
+    z = e[start - first * STREAM: stop - first * STREAM] @ chol.T
     dev = np.where(uniform, 2 * ndtr(z) - 1, z) * relwidth
     P = np.tile(nominal, (stop - start, 1))
     P[:, index] *= 1 + dev
@@ -132,10 +137,10 @@ def valid(model: Model, P: np.ndarray) -> np.ndarray:
     return ok
 
 
-def chunk(start, stop, model_ref, nominal, index, relwidth, uniform, chol, seed, size=CHUNK):
+def chunk(start, stop, model_ref, nominal, index, relwidth, uniform, chol, seed):
     """One chunk of the study: the samples' frequencies (NaN where failed) and spin rates."""
     model = load(model_ref)
-    P = samples(nominal, index, relwidth, uniform, chol, seed, start, stop, size)
+    P = samples(nominal, index, relwidth, uniform, chol, seed, start, stop)
     ok = valid(model, P)
     n = len(model.meta["reduced"])
     freq = np.full((stop - start, n), np.nan)
@@ -152,8 +157,8 @@ def chunk(start, stop, model_ref, nominal, index, relwidth, uniform, chol, seed,
 def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: int = 0,
               pairs: dict | None = None, scheduler=None, harmonics=(), band: float = 0.02,
               store: Path | None = None, progress: bool = False, size: int = CHUNK) -> ToleranceStudy:
-    """The study over n samples; `size` samples a chunk (with the seed, it fixes the
-    samples: chunk c draws from the generator seeded with (seed, c))."""
+    """The study over n samples, `size` samples a chunk (the samples and the answer do not
+    depend on it: the random streams come in blocks of STREAM)."""
     from gyro.analyses.sensitivity import sensitivities
 
     names = [s.name for s in spreads]
@@ -166,6 +171,8 @@ def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: i
         raise ParameterError("--spread: a parameter is given twice")
     if harmonics and spin_rate(model, model.vector(values)[None]) is None:
         raise ParameterError(f"--harmonics: {model.name} has no spin rate H/C (parameters H and C)")
+    if harmonics and not spin_rate(model, model.vector(values)[None])[0] > 0:
+        raise ParameterError("--harmonics: the rotor does not spin (H = 0): no harmonic k omega_c to fall on")
     corr = correlation(spreads, pairs or {})
     chol = np.linalg.cholesky(corr)
     nominal = model.vector(values)
@@ -187,7 +194,7 @@ def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: i
         folder = Path(tmp.name)
     try:
         ref = model_ref(model)
-        out = executor.run(chunk, n, size, (ref, nominal, index, relwidth, uniform, chol, seed, size), scheduler,
+        out = executor.run(chunk, n, size, (ref, nominal, index, relwidth, uniform, chol, seed), scheduler,
                            folder, progress, "tolerance", warm=warm, warm_args=(ref,))
         F = out["frequencies"]
         ok = np.all(np.isfinite(F), axis=1)
@@ -228,8 +235,12 @@ def _stats(F, ok):
             kurt[i] = np.mean(dev**4) / std[i] ** 4
         q[i] = np.quantile(col, QUANTILES)
         lo, hi = np.quantile(col, (0.0005, 0.9995))
-        if not hi > lo:
-            lo, hi = col.min() - 0.5, col.max() + 0.5
+        if not hi - lo > 1e-9 * max(abs(lo), abs(hi)):
+            # a frequency the spreads do not move (omega_p = sqrt(Kp/m) under a spread of H):
+            # its samples differ by rounding only, too little for BINS bins of their own
+            mid = 0.5 * (lo + hi)
+            half = 1e-6 * abs(mid) if mid != 0 else 0.5
+            lo, hi = min(mid - half, col.min()), max(mid + half, col.max())
         counts[i], edges[i] = np.histogram(col, bins=BINS, range=(lo, hi))
     return mean, std, skew, kurt, q, counts, edges
 
@@ -251,13 +262,19 @@ def _bands(F, ok, spin, harmonics, band, nominal_freq, dfreq, model, nominal, co
         for k in harmonics:
             with np.errstate(invalid="ignore"):
                 inside = ok & (np.abs(col / (k * spin) - 1) < band)
-            # first order: x = omega_i - k omega_c normal with the linearised mean and std;
-            # the band |x| < band k omega_c taken at the nominal omega_c
-            g = dfreq[i][index] - k * dwc[index]
-            s = float(np.sqrt(g @ cov @ g))
-            mu = nominal_freq[i] - k * wc0
-            half = band * k * wc0
-            fo = (float(ndtr((half - mu) / s) - ndtr((-half - mu) / s)) if s > 0 else float(abs(mu) < half))
+            # first order: the band is (1 - band) k omega_c < omega_i < (1 + band) k omega_c,
+            # both edges moving with omega_c; with y_e = omega_i - e k omega_c linearised
+            # (normal, mean mu_e, std s_e) and y_lower > y_upper, P = P(y_lower > 0) -
+            # P(y_upper > 0). Each edge has its own std: omega_c enters it with the factor
+            # e k, not k (a band of 55 % and a 1 % spread of C: 0.25 against the sampled
+            # 0.066 with k alone)
+            fo = 0.0
+            for e, sign in ((1 - band, 1.0), (1 + band, -1.0)):
+                g = dfreq[i][index] - e * k * dwc[index]
+                s = float(np.sqrt(g @ cov @ g))
+                mu = nominal_freq[i] - e * k * wc0
+                # no sensitivities (a double root at the nominal set): no first order, NaN
+                fo += sign * (float(ndtr(mu / s)) if s > 0 else float(mu > 0) if s == 0 else np.nan)
             row.append({"harmonic": k, "omega": k * wc0, "probability": int(inside.sum()) / n_ok,
                         "first_order_probability": fo})
         out.append(row)

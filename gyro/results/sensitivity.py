@@ -43,9 +43,14 @@ class Sensitivities:
         """Per frequency, the parameters that move it most (relative sensitivity)."""
         rel = self.relative[k]
         lines = ["relative sensitivities (p/omega) d omega/d p, the largest three per frequency:"]
+        # a root without an error bound (the method cannot tell) leaves every root's distance
+        # to it unknown: no derivative, and not because the roots are known to be double
+        unbounded = not np.all(np.isfinite(self.spectrum.error_estimate[k]))
         for i, row in enumerate(rel, 1):
             if self.double[k, i - 1] or not np.any(np.isfinite(row)):
-                lines.append(f"{i:>4}   a double or nearly double root: no derivative")
+                why = ("a root's error is unbounded (try --method default)" if unbounded
+                       else "a double or nearly double root")
+                lines.append(f"{i:>4}   {why}: no derivative")
                 continue
             order = np.argsort(-np.abs(np.where(np.isfinite(row), row, 0.0)))[:top]
             lines.append(f"{i:>4}   " + "   ".join(f"{self.param_names[j]:>6} {row[j]:+.4f}" for j in order))

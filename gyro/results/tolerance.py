@@ -83,7 +83,9 @@ class ToleranceStudy:
                "sensitivity_parameters": list(self.sensitivities.param_names), "failed": self.failed}
         if self.band_probability is not None:
             doc["band"] = self.band
-            doc["band_probability"] = self.band_probability
+            # a mode without a first order (a double root at the nominal set): null
+            doc["band_probability"] = [[{**b, "first_order_probability": _num(b["first_order_probability"])}
+                                        for b in row] for row in self.band_probability]
         return doc
 
     def table(self) -> str:
@@ -94,7 +96,10 @@ class ToleranceStudy:
                  f"{'q 0.99':>12}  first order"]
         holds, err = self.first_order_holds(), self.first_order_error()
         for i in range(len(self.nominal)):
-            verdict = ("holds" if holds[i] else "fails") + (f" ({100 * err[i]:+.1f} %)" if np.isfinite(err[i]) else "")
+            if np.isfinite(self.first_order_std[i]):
+                verdict = ("holds" if holds[i] else "fails") + (f" ({100 * err[i]:+.1f} %)" if np.isfinite(err[i]) else "")
+            else:
+                verdict = "none (a double root at the nominal set)"
             lines.append(f"{i + 1:>4} {self.nominal[i]:>12.6g} {self.mean[i]:>12.6g} {self.std[i]:>11.4g} "
                          f"{self.first_order_std[i]:>13.4g} {self.quantiles[i, 0]:>12.6g} {self.quantiles[i, 2]:>12.6g}"
                          f"  {verdict}")
@@ -104,8 +109,10 @@ class ToleranceStudy:
                          "(sampled / first order):")
             shown = 0
             for i, row in enumerate(self.band_probability, 1):
-                cells = [f"k={b['harmonic']}: {b['probability']:.3g} / {b['first_order_probability']:.3g}" for b in row]
-                if any(b["probability"] > 0 or b["first_order_probability"] > 1e-6 for b in row):
+                fo = [b["first_order_probability"] for b in row]
+                cells = [f"k={b['harmonic']}: {b['probability']:.3g} / " + (f"{f:.3g}" if np.isfinite(f) else "none")
+                         for b, f in zip(row, fo)]
+                if any(b["probability"] > 0 or not f <= 1e-6 for b, f in zip(row, fo)):  # NaN: shown
                     lines.append(f"{i:>4}   " + "   ".join(cells))
                     shown += 1
             if not shown:

@@ -203,7 +203,8 @@ def _check_reducible(model: Model, L0, Q0, L_in, Q) -> None:
         c, v = model.coordinate(cname), model.velocity(cname)
         what = "cyclic" if cname in model.cyclic else "turning steadily"
         if not mech.is_cyclic(L0, c):
-            raise Unsupported(f"{model.name}: {cname} ({what}) appears in the Lagrangian")
+            raise Unsupported(f"{model.name}: {cname} ({what}) appears in the Lagrangian; a term with the "
+                              f"angle itself (a mass unbalance at {cname}) is a forcing: {UNBALANCE_HINT}")
         L0 = L0.subs(c, 0)
         if L_in is not None and not mech.is_cyclic(L_in, c):
             raise Unsupported(f"{model.name}: an input term of the Lagrangian depends on {cname} ({what})")
@@ -221,6 +222,24 @@ def _check_reducible(model: Model, L0, Q0, L_in, Q) -> None:
                     p.has(fn) for fn in model.given_functions):
                 raise Unsupported(f"{model.name}: an input enters the momentum of the cyclic {cname}")
     return L0
+
+
+UNBALANCE_HINT = ("write it as two force inputs (Signal('Fx', 'N', ..., input=True, order=0) and 'Fy', "
+                  "with a Load on the rates of the rotor's centre) and use `gyro unbalance MODEL --force-x Fx "
+                  "--force-y Fy --magnitude ME` (docs/models.md)")
+
+
+def _refuse_time_forcing(model: Model, order, residual) -> None:
+    """Explicit time in the reference's own equations (a mass unbalance at the angle W t, a
+    force F cos(w t)) is a forcing: the reference is then no equilibrium, and no operator
+    about it exists at any instant. Time in the operator alone (a support shaken under a
+    pendulum at rest, the Mathieu form) stays."""
+    timed = [c for c, r in zip(order, residual)
+             if TIME in sp.sympify(r).free_symbols and sp.simplify(sp.diff(r, TIME)) != 0]
+    if timed:
+        raise Unsupported(f"{model.name}: the explicit time t enters the equilibrium equations of "
+                          f"{', '.join(timed)}: a time-dependent forcing (a mass unbalance written as W t, "
+                          f"say) leaves no equilibrium to linearise about; {UNBALANCE_HINT}")
 
 
 def derive(model: Model, steps: Steps | None = None) -> Derivation:
@@ -290,6 +309,8 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
 
     with steps("equations of the reference and their symmetric zeros"):
         residual = mech.equilibrium_equations(R, rq, rqd, at=zero_set, rates=rates, Q=Q0r, signals=signals)
+        if time_dependent:
+            _refuse_time_forcing(model, order, residual)
         for c in model.symmetric_zero:
             r = sp.expand(residual[order.index(c)])
             if r != 0:

@@ -229,13 +229,19 @@ UNBALANCE_HINT = ("write it as two force inputs (Signal('Fx', 'N', ..., input=Tr
                   "--force-y Fy --magnitude ME` (docs/models.md)")
 
 
-def _refuse_time_forcing(model: Model, order, residual) -> None:
-    """Explicit time in the reference's own equations (a mass unbalance at the angle W t, a
-    force F cos(w t)) is a forcing: the reference is then no equilibrium, and no operator
-    about it exists at any instant. Time in the operator alone (a support shaken under a
-    pendulum at rest, the Mathieu form) stays."""
-    timed = [c for c, r in zip(order, residual)
-             if TIME in sp.sympify(r).free_symbols and sp.simplify(sp.diff(r, TIME)) != 0]
+def _refuse_time_forcing(model: Model, order, residual, even) -> None:
+    """Explicit time in the reference's own equations that no equilibrium can absorb (a mass
+    unbalance at the angle W t, a force F cos(w t)) is a forcing: a constant equilibrium qe
+    needs r(qe, t) = 0 at every t, hence dr/dt(qe, t) = 0; a row whose dr/dt is not zero
+    and free of the equilibrium coordinates has no such qe, so no operator about one exists.
+    Time that multiplies a function of qe (a support shaken under a pendulum, sin(theta)
+    times sin(w t): zero at theta = 0) stays: the Mathieu form."""
+    timed = []
+    for c, r in zip(order, residual):
+        if TIME in sp.sympify(r).free_symbols:
+            dr = sp.simplify(sp.diff(r, TIME))
+            if dr != 0 and not (dr.free_symbols & set(even)):
+                timed.append(c)
     if timed:
         raise Unsupported(f"{model.name}: the explicit time t enters the equilibrium equations of "
                           f"{', '.join(timed)}: a time-dependent forcing (a mass unbalance written as W t, "
@@ -310,7 +316,7 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
     with steps("equations of the reference and their symmetric zeros"):
         residual = mech.equilibrium_equations(R, rq, rqd, at=zero_set, rates=rates, Q=Q0r, signals=signals)
         if time_dependent:
-            _refuse_time_forcing(model, order, residual)
+            _refuse_time_forcing(model, order, residual, even)
         for c in model.symmetric_zero:
             r = sp.expand(residual[order.index(c)])
             if r != 0:

@@ -77,6 +77,10 @@ def test_a_parametric_excitation_derives_and_the_runtime_refuses_its_time_depend
     got 2', exit 1: a failure at valid input that was not numerical)."""
     d = _derive(_model("mathieu_pendulum"))
     assert d.time_dependent
+    # theta not declared zero: the residual m l (g - a w^2 sin w t) sin(theta) carries t, but
+    # its d/dt depends on theta and vanishes at theta = 0, so an equilibrium can absorb it
+    free = _derive(dataclasses.replace(_model("mathieu_pendulum"), symmetric_zero=[]))
+    assert free.time_dependent and free.model.symmetric_zero == []
     path = str(MODELS / "mathieu_pendulum.py")
     for args in (["frequencies", path, "--json"], ["campbell", path, "--spin", "w", "--json"],
                  ["sweep", path, "--x", "w", "--x-range", "1", "10"]):

@@ -203,7 +203,8 @@ def _check_reducible(model: Model, L0, Q0, L_in, Q) -> None:
         c, v = model.coordinate(cname), model.velocity(cname)
         what = "cyclic" if cname in model.cyclic else "turning steadily"
         if not mech.is_cyclic(L0, c):
-            raise Unsupported(f"{model.name}: {cname} ({what}) appears in the Lagrangian")
+            raise Unsupported(f"{model.name}: {cname} ({what}) appears in the Lagrangian; a term with the "
+                              f"angle itself (a mass unbalance at {cname}) is a forcing: {UNBALANCE_HINT}")
         L0 = L0.subs(c, 0)
         if L_in is not None and not mech.is_cyclic(L_in, c):
             raise Unsupported(f"{model.name}: an input term of the Lagrangian depends on {cname} ({what})")
@@ -221,6 +222,30 @@ def _check_reducible(model: Model, L0, Q0, L_in, Q) -> None:
                     p.has(fn) for fn in model.given_functions):
                 raise Unsupported(f"{model.name}: an input enters the momentum of the cyclic {cname}")
     return L0
+
+
+UNBALANCE_HINT = ("write it as two force inputs (Signal('Fx', 'N', ..., input=True, order=0) and 'Fy', "
+                  "with a Load on the rates of the rotor's centre) and use `gyro unbalance MODEL --force-x Fx "
+                  "--force-y Fy --magnitude ME` (docs/models.md)")
+
+
+def _refuse_time_forcing(model: Model, order, residual, even) -> None:
+    """Explicit time in the reference's own equations that no equilibrium can absorb (a mass
+    unbalance at the angle W t, a force F cos(w t)) is a forcing: a constant equilibrium qe
+    needs r(qe, t) = 0 at every t, hence dr/dt(qe, t) = 0; a row whose dr/dt is not zero
+    and free of the equilibrium coordinates has no such qe, so no operator about one exists.
+    Time that multiplies a function of qe (a support shaken under a pendulum, sin(theta)
+    times sin(w t): zero at theta = 0) stays: the Mathieu form."""
+    timed = []
+    for c, r in zip(order, residual):
+        if TIME in sp.sympify(r).free_symbols:
+            dr = sp.simplify(sp.diff(r, TIME))
+            if dr != 0 and not (dr.free_symbols & set(even)):
+                timed.append(c)
+    if timed:
+        raise Unsupported(f"{model.name}: the explicit time t enters the equilibrium equations of "
+                          f"{', '.join(timed)}: a time-dependent forcing (a mass unbalance written as W t, "
+                          f"say) leaves no equilibrium to linearise about; {UNBALANCE_HINT}")
 
 
 def derive(model: Model, steps: Steps | None = None) -> Derivation:
@@ -290,6 +315,8 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
 
     with steps("equations of the reference and their symmetric zeros"):
         residual = mech.equilibrium_equations(R, rq, rqd, at=zero_set, rates=rates, Q=Q0r, signals=signals)
+        if time_dependent:
+            _refuse_time_forcing(model, order, residual, even)
         for c in model.symmetric_zero:
             r = sp.expand(residual[order.index(c)])
             if r != 0:

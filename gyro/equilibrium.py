@@ -13,12 +13,27 @@ from __future__ import annotations
 
 import numpy as np
 
+from gyro.errors import ParameterError
 from gyro.kernels import function
 from gyro.models import Model
 
 
 class EquilibriumError(RuntimeError):
     pass
+
+
+def require_time_free(model: Model) -> None:
+    """An operator about an equilibrium needs equations free of the explicit time t: a model
+    emitted with t in its equilibrium equations or its operator (metadata 'time_dependent';
+    the derivation now refuses a time-dependent forcing, a parametric excitation still
+    derives) is refused in one line here, before any function is called without its time."""
+    timed = [f for f in ("equilibrium_residual", "operator")
+             if any(g["name"] == "time" for g in model.meta["functions"].get(f, {}).get("inputs", []))]
+    if timed:
+        raise ParameterError(f"{model.name}: its {' and '.join(timed)} depend on the explicit time t: the "
+                             "analyses take a constant operator about an equilibrium; write a time-dependent "
+                             "forcing (a mass unbalance) as force inputs and use `gyro unbalance` "
+                             "(docs/models.md); a parametric excitation needs a Floquet analysis, not built")
 
 
 MAX_ANGLE_STEP = 0.2  # rad: Newton steps on angles are damped to stay on the branch of (2.2)
@@ -53,6 +68,7 @@ def _layout(model: Model):
 def equilibria(model: Model, P: np.ndarray, tol: float = TOL, max_iter: int = MAX_ITER):
     """Relative equilibria of a batch P (sets, parameters). Returns (qe, ok): qe (sets,
     equilibrium coordinates), NaN where ok is False."""
+    require_time_free(model)
     P = np.atleast_2d(np.asarray(P, dtype=float))
     names, idx, is_angle = _layout(model)
     n = P.shape[0]
@@ -117,5 +133,6 @@ def equilibrium(model: Model, params) -> np.ndarray:
 
 def operators(model: Model, P: np.ndarray, qe: np.ndarray):
     """M, D, K of a batch at its equilibria."""
+    require_time_free(model)
     with np.errstate(all="ignore"):
         return function(model, "operator")(P, qe)

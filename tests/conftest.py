@@ -25,7 +25,7 @@ TIERS = {
     "methods": ("test_ladder", "test_sensitivity", "test_hierarchy", "test_harmonic", "test_block_starts", "test_anymodel"),
     "properties": ("test_properties",),
     "cli": ("test_cli", "test_gimbal_simulate", "test_readme", "test_sweep", "test_wheel", "test_ghc_cli", "test_fuzz", "test_robustness",
-            "test_tolerance", "test_executor", "test_precession_cli", "test_forced"),
+            "test_tolerance", "test_executor", "test_precession_cli", "test_forced", "test_unbalance_lagrangian"),
 }
 _TIER_OF = {f: tier for tier, files in TIERS.items() for f in files}
 

@@ -9,7 +9,7 @@ import pytest
 
 from tests.conftest import ROOT
 
-NAMES = "m M l l1 l2 A C I1 I2 I3 K0 Kp Kgamma H u phi g".split()
+NAMES = "m M l l1 l2 A C I1 I2 I3 K0 Kp Kgamma H u phi g h cp c0 cgamma".split()
 
 
 def gyro(*args):

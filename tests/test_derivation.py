@@ -53,14 +53,24 @@ def _numeric(mat, rng):
     return np.array(sp.N(mat.xreplace(pt), 30).tolist(), dtype=float), pt
 
 
+DAMPING = ("cp", "c0", "cgamma")  # the optional bearing damping (docs/forced.md), 0 by default
+
+
 def test_operator_structure(tg_derivation):
-    """M and K symmetric, D skew, M positive definite at random points; det J(p) even."""
+    """M and K symmetric, M positive definite at random points; without the optional bearing
+    damping D is skew (gyroscopic) and det J(p) even; with it, D's symmetric part is the
+    Rayleigh function's positive semidefinite matrix, and D's skew part is unchanged."""
     op = tg_derivation.operator
     rng = random.Random(3)
     for _ in range(3):
         syms = sorted(set().union(op.M.free_symbols, op.D.free_symbols, op.K.free_symbols), key=str)
         pt = {s: sp.Rational(rng.randint(100, 900), 1000) for s in syms}
+        damped = np.array(sp.N(op.D.xreplace(pt), 30).tolist(), dtype=float)
+        pt.update({s: 0 for s in syms if str(s) in DAMPING})
         M, D, K = (np.array(sp.N(X.xreplace(pt), 30).tolist(), dtype=float) for X in (op.M, op.D, op.K))
+        sym = (damped + damped.T) / 2
+        assert np.linalg.eigvalsh(sym).min() >= -1e-14 * np.abs(sym).max() and np.abs(sym).max() > 0
+        np.testing.assert_allclose((damped - damped.T) / 2, D, rtol=0, atol=1e-14 * np.abs(D).max())
         np.testing.assert_allclose(M, M.T, rtol=0, atol=1e-14 * np.abs(M).max())
         np.testing.assert_allclose(K, K.T, rtol=0, atol=1e-14 * np.abs(K).max())
         np.testing.assert_allclose(D, -D.T, rtol=0, atol=1e-14 * np.abs(D).max())

@@ -203,6 +203,8 @@ def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
     radius = np.where(resolved & (lam > 0), np.where(resolved, est, 0.0) * lam, -np.inf)  # -inf: meets none
     merged = np.any(verdict.overlapping(spec.growth + 1j * spec.frequencies, radius), axis=2) & resolved
     unresolved = bounded & ~resolved & (lam > 0)
+    if spec.steady is not None:  # a steady coordinate's own zero root is zero by construction
+        unresolved &= ~spec.steady
     boundary = (merged | unresolved).any(axis=1)
     label = np.where(failed, "failed", np.where(
         growing.any(axis=1), "unstable", np.where(

@@ -17,6 +17,12 @@ def functions(d) -> list[Function]:
     op = d.operator
     wrt = list(d.model.symbols) + list(d.even)
     entries = [e for X in (op.M, op.D, op.K) for e in X]  # row-major M, then D, then K
+    kinks = (sp.sign, sp.Heaviside, sp.Piecewise, sp.Abs, sp.Max, sp.Min, sp.DiracDelta)
+    if any(e.has(*kinks) for e in entries) or d.equilibrium_residual.has(*kinks):
+        # an operator with a kink (derive/nonsmooth.py) has no derivative where its argument
+        # vanishes, and SymPy's would carry DiracDelta and unevaluated Derivatives: no
+        # emitted sensitivities (the runtime's CasADi route differentiates away from kinks)
+        return []
     dJ = sp.Matrix([[sp.diff(e, w) for w in wrt] for e in entries])
     dr = d.equilibrium_residual.jacobian(wrt)
     names = ", ".join(str(w) for w in wrt)

@@ -17,3 +17,26 @@ def finite_number(label: str, raw) -> float:
     if not math.isfinite(value):
         raise ParameterError(f"{label}: must be a finite number, got {raw!r}")
     return value
+
+
+def grid_axis(flag: str, text: str, names, most: int, what: str = "axis") -> tuple[str, float, float, int]:
+    """A map's axis NAME=LO:HI:N -> (name, lo, hi, n): NAME one of `names` (an unknown one is
+    called an unknown `what`), LO < HI finite, 2 <= N <= `most`; otherwise ParameterError
+    naming the flag."""
+    name, sep, rng = str(text).partition("=")
+    parts = rng.split(":")
+    if not sep or len(parts) != 3:
+        raise ParameterError(f"{flag} {text!r}: expected NAME=LO:HI:N")
+    name = name.strip()
+    if name not in names:
+        raise ParameterError(f"{flag} {name!r}: unknown {what}; known: {' '.join(names)}")
+    lo, hi = (finite_number(f"{flag} {name}", p) for p in parts[:2])
+    try:
+        n = int(parts[2])
+    except ValueError:
+        raise ParameterError(f"{flag} {name}: N not an integer: {parts[2]!r}") from None
+    if not lo < hi:
+        raise ParameterError(f"{flag} {name}: need LO < HI, got {lo!r}:{hi!r}")
+    if not 2 <= n <= most:
+        raise ParameterError(f"{flag} {name}: N must lie in [2, {most}], got {n}")
+    return name, lo, hi, n

@@ -30,14 +30,13 @@ from dataclasses import replace
 import numpy as np
 
 from gyro.equilibrium import operators
-from gyro.errors import finite_number
+from gyro.errors import finite_number, grid_axis
 from gyro.kernels import function
 from gyro.models import ParameterError, load
 from gyro.qep import companion_matrix
 from gyro.results import verdict
 
 MODEL = "gyrohorizoncompass"
-CLI_NAMES = {"lambda": "lam"}  # the model file's CLI_NAMES (command line -> model symbol)
 NAMES = ("A", "B", "C", "J", "L", "I", "nu", "zeta", "eta", "lambda")
 DERIVED = ("theta", "chi")  # map axes besides the parameters
 U = 2.0**-53  # the unit roundoff of double precision
@@ -56,7 +55,8 @@ def model():
 
 
 def cli_name(name: str) -> str:
-    return {v: k for k, v in CLI_NAMES.items()}.get(name, name)
+    """The name a user types for a parameter (the model's aliases: lambda for lam)."""
+    return {v: k for k, v in model().meta.get("aliases", {}).items()}.get(name, name)
 
 
 def _number(name: str, raw) -> float:
@@ -66,7 +66,7 @@ def _number(name: str, raw) -> float:
 def _check(name: str, value: float) -> None:
     """The model's own check of a parameter, its message naming the command-line name."""
     by_name = {p.name: p for p in model().params}
-    replace(by_name[CLI_NAMES.get(name, name)], name=name).check(value)
+    replace(by_name[model().canonical(name)], name=name).check(value)
 
 
 def parameters(sets: dict | None = None, orbit: bool = False, base: dict | None = None,
@@ -85,7 +85,7 @@ def parameters(sets: dict | None = None, orbit: bool = False, base: dict | None 
             raise ParameterError(f"unknown parameter {key!r} for {MODEL}; known: {' '.join(NAMES)}")
         v = _number(key, raw)
         _check(key, v)
-        values[CLI_NAMES.get(key, key)] = v
+        values[model().canonical(key)] = v
         given.add(key)
     if orbit:
         for key in ("zeta", "eta"):
@@ -123,7 +123,7 @@ def with_axis(values: dict, name: str, value: float) -> dict:
     elif name == "chi":
         v["B"] = v["C"] - value * v["I"]
     else:
-        v[CLI_NAMES.get(name, name)] = value
+        v[model().canonical(name)] = value
     return v
 
 
@@ -322,25 +322,9 @@ def energy_bound(values: dict) -> float:
 # ------------------------------------------------------------------ maps
 
 
-def parse_axis(flag: str, text: str, m=None) -> tuple[str, float, float, int]:
-    """NAME=LO:HI:N -> (name, lo, hi, n), or ParameterError naming the flag."""
-    name, sep, rng = str(text).partition("=")
-    parts = rng.split(":")
-    if not sep or len(parts) != 3:
-        raise ParameterError(f"{flag} {text!r}: expected NAME=LO:HI:N")
-    name = name.strip()
-    if name not in NAMES + DERIVED:
-        raise ParameterError(f"{flag} {name!r}: unknown axis; known: {' '.join(NAMES + DERIVED)}")
-    lo, hi = (_number(f"{flag} {name}", p) for p in parts[:2])
-    try:
-        n = int(parts[2])
-    except ValueError:
-        raise ParameterError(f"{flag} {name}: N not an integer: {parts[2]!r}") from None
-    if not lo < hi:
-        raise ParameterError(f"{flag} {name}: need LO < HI, got {lo!r}:{hi!r}")
-    if not 2 <= n <= 1000:
-        raise ParameterError(f"{flag} {name}: N must lie in [2, 1000], got {n}")
-    return name, lo, hi, n
+def parse_axis(flag: str, text: str) -> tuple[str, float, float, int]:
+    """NAME=LO:HI:N over a parameter or theta, chi -> (name, lo, hi, n)."""
+    return grid_axis(flag, text, NAMES + DERIVED, 1000)
 
 
 def condition_map(base: dict, xaxis, yaxis, orbit: bool = False, lambda_follows: bool = True):

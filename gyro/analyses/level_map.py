@@ -14,30 +14,14 @@ import numpy as np
 
 from gyro import levels as hierarchy
 from gyro import questions
-from gyro.errors import ParameterError, finite_number
+from gyro.errors import ParameterError, grid_axis
 
 MAX_POINTS = 10**4  # grid points of one map
 
 
 def parse_axis(flag: str, text: str, names) -> tuple[str, float, float, int]:
-    """NAME=LO:HI:N -> (name, lo, hi, n), or ParameterError naming the flag."""
-    name, sep, rng = str(text).partition("=")
-    parts = rng.split(":")
-    if not sep or len(parts) != 3:
-        raise ParameterError(f"{flag} {text!r}: expected NAME=LO:HI:N")
-    name = name.strip()
-    if name not in names:
-        raise ParameterError(f"{flag} {name!r}: unknown parameter; known: {' '.join(names)}")
-    lo, hi = (finite_number(f"{flag} {name}", p) for p in parts[:2])
-    try:
-        n = int(parts[2])
-    except ValueError:
-        raise ParameterError(f"{flag} {name}: N not an integer: {parts[2]!r}") from None
-    if not lo < hi:
-        raise ParameterError(f"{flag} {name}: need LO < HI, got {lo!r}:{hi!r}")
-    if not 2 <= n <= 200:
-        raise ParameterError(f"{flag} {name}: N must lie in [2, 200], got {n}")
-    return name, lo, hi, n
+    """NAME=LO:HI:N over one of `names` -> (name, lo, hi, n)."""
+    return grid_axis(flag, text, names, 200, "parameter")
 
 
 def question_of(model, level: str, against: str, question: str | None = None) -> str:

@@ -28,7 +28,6 @@ from gyro.models import load
 
 MODEL = "gimbal_precession"
 LEVELS = ("full", "rigorous", "image", "small", "elementary")  # most exact first
-CLI_NAMES = {"M_motor": "Mmotor"}  # the model file's CLI_NAMES (command line -> model symbol)
 SINGULAR_COS = 1e-3  # |cos beta| (or |cos alpha|) below this: at the singularity (|angle| > 89.94 deg)
 RTOL, ATOL = 1e-12, 1e-14
 MAX_STEPS = 2 * 10**6  # full, between two output times: its nutation at H/J rad/s sets the step
@@ -42,7 +41,8 @@ class Singular(ParameterError):
 
 
 def cli_name(name: str) -> str:
-    return {v: k for k, v in CLI_NAMES.items()}.get(name, name)
+    """The name a user types for a parameter (the model's aliases: M_motor for Mmotor)."""
+    return {v: k for k, v in load(MODEL).meta.get("aliases", {}).items()}.get(name, name)
 
 
 def parameters(sets: dict | None = None) -> dict:
@@ -55,7 +55,7 @@ def parameters(sets: dict | None = None) -> dict:
     for key, raw in (sets or {}).items():
         if key not in known:
             raise ParameterError(f"unknown parameter {key!r} for {MODEL}; known: {' '.join(known)}")
-        out[CLI_NAMES.get(key, key)] = finite_number(f"parameter {key}", raw)
+        out[model.canonical(key)] = finite_number(f"parameter {key}", raw)
     return model.parameters(out)
 
 
@@ -119,8 +119,6 @@ def initial_state(level: str, values: dict) -> np.ndarray:
 def simulate(values: dict, t, level: str, rtol_scale: float = 1.0):
     """The motion of one level at the times t (t[0] = 0): ImagePointMotion. Singular when it
     reaches beta or alpha = +-90 deg; FloatingPointError when the integrator fails."""
-    import casadi as ca
-
     from gyro.results import ImagePointMotion
 
     if level not in LEVELS:

@@ -172,15 +172,16 @@ def test_driven_chain_against_its_closed_form_and_unbalance(chain):
 
 def test_unbalance_on_torsion_gyrocompass_is_the_rotating_force():
     """The unbalance on F1, F3 (the two radial bearing forces) over a range of H: each row is
-    the harmonic response to u = m e W^2 e^{i PHI} (1, 0, -i) at W = omega_c of its set."""
-    from gyro.analyses.forced import spin_rate
+    the harmonic response to u = m e W^2 e^{i PHI} (1, 0, -i) at the model's declared spin
+    rate W = H/C of its set (the one the Campbell diagram and its harmonic lines use)."""
+    from gyro.analyses.spin import spin_rates
 
     me, phi = 2e-6, 0.3
     r = unbalance_response(MODEL, {"cp": 1.0}, "F1", "F3", me, phi, "H", 0.1, 0.6, 4)
     P = r.params
-    qe, _ = equilibria(MODEL, P)
-    W = spin_rate(MODEL, P, qe)
-    assert np.array_equal(r.omega, W)
+    W = spin_rates(MODEL, "H", P)
+    H, C = (P[:, MODEL.param_names.index(n)] for n in ("H", "C"))
+    assert np.allclose(W, H / C, rtol=1e-15, atol=0) and np.array_equal(r.omega, W)
     u = me * W[:, None]**2 * np.exp(1j * phi) * np.array([1.0, 0.0, -1j])
     direct = harmonic_response(MODEL, P, W, u)
     assert np.allclose(r.X, direct.X, rtol=1e-14, atol=0)

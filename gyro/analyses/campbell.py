@@ -13,7 +13,7 @@ import numpy as np
 
 from gyro import ladder, qep
 from gyro.equilibrium import equilibria, operators
-from gyro.kernels import function
+from gyro.analyses.spin import spin_parameter, spin_rates  # noqa: F401  (spin_parameter: the CLI's)
 from gyro.models import Model, ParameterError
 from gyro.results import CampbellDiagram, Spectrum
 from gyro.results.campbell import Crossing
@@ -71,33 +71,6 @@ def batch_default(model: Model, P: np.ndarray, progress=False, desc="default", b
         if bar is not None:
             bar.close()
     return Spectrum.concat(parts) if parts else ladder.spectrum(model, P, "default")
-
-
-def spin_parameter(model: Model, name: str | None) -> str:
-    """The parameter that sets the spin: `name`, or the model's declared one. A parameter
-    that is neither declared nor in rad/s is refused (its spin rate would be a guess)."""
-    declared = model.meta.get("spin", {}).get("parameter")
-    if name is None:
-        if declared is None:
-            raise ParameterError(f"--spin: {model.name} declares no spin parameter; name one in rad/s "
-                                 f"(--spin NAME; parameters: {' '.join(model.param_names)})")
-        return declared
-    if name not in model.param_names:
-        raise ParameterError(f"--spin {name!r}: unknown parameter; known: {' '.join(model.param_names)}")
-    unit = model.params[model.param_names.index(name)].unit
-    if name != declared and unit != "rad/s":
-        raise ParameterError(f"--spin {name!r}: its unit is {unit}, not rad/s, and {model.name} declares "
-                             + (f"the spin as {declared}" if declared else "no spin rate for it (Model.spin)"))
-    return name
-
-
-def spin_rates(model: Model, spin: str, P: np.ndarray) -> np.ndarray:
-    """The spin rate in rad/s of each set: the model's emitted spin_rate where it declares
-    `spin`, the parameter itself otherwise."""
-    if model.meta.get("spin", {}).get("parameter") == spin:
-        with np.errstate(all="ignore"):
-            return np.asarray(function(model, "spin_rate")(P)[0], float).reshape(len(P))
-    return P[:, model.param_names.index(spin)].copy()
 
 
 def mac(a: np.ndarray, b: np.ndarray) -> np.ndarray:

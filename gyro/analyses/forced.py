@@ -22,7 +22,7 @@ import numpy as np
 
 from gyro import ladder
 from gyro.analyses.harmonic import harmonic_response
-from gyro.analyses.spin import MODELS, sets_spin, spin_rate  # noqa: F401  (sets_spin re-exported)
+from gyro.analyses.spin import MODELS, spin_rate
 from gyro.equilibrium import operators
 from gyro.models import Model, ParameterError
 from gyro.results.harmonic import ForcedResponse, HarmonicResponse

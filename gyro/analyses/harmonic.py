@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gyro.analyses.spin import spin_rates
+from gyro.analyses.spin import spin_parameter, spin_rates
 from gyro.equilibrium import EquilibriumError, equilibria, tame
 from gyro.kernels import chunks, function
 from gyro.models import Model, ParameterError
@@ -198,15 +198,14 @@ def unbalance_response(model: Model, values: dict, force_x: str, force_y: str, m
     if not np.isfinite(phase):
         raise ParameterError(f"--phase: need a finite angle in radians, got {phase!r}")
     values = dict(values)
-    if spin not in model.param_names:
-        raise ParameterError(f"--spin {spin!r}: unknown parameter; known: {' '.join(model.param_names)}")
+    spin = spin_parameter(model, spin)  # declared, or in rad/s: refused otherwise
     xs = np.linspace(lo, hi, points)
     P = np.tile(model.vector(values), (points, 1))
     P[:, model.param_names.index(spin)] = xs
     parts = []
     for sl in chunks(points, CHUNK, progress, "unbalance"):
         qe, ok = equilibria(model, P[sl])
-        W = spin_rates(model, P[sl], spin, qe)
+        W = spin_rates(model, spin, P[sl])
         u = np.zeros((len(W), len(names)), complex)
         rot = magnitude * W**2 * np.exp(1j * phase)
         u[:, names.index(force_x)] = rot

@@ -22,7 +22,7 @@ def register(sub) -> None:
     s.add_argument("--magnitude", required=True, type=float, metavar="ME", help="unbalance m e [kg m]")
     s.add_argument("--phase", type=float, default=0.0, metavar="PHI", help="its angle [rad] (default 0)")
     s.add_argument("--spin", metavar="NAME", default=None,
-                   help="the parameter that sets the spin (a rate in rad/s, or H of the torsion gyrocompass)")
+                   help="the parameter that sets the spin (the model's declared one, as H of the torsion gyrocompass, or a rate in rad/s)")
     s.add_argument("--spin-range", nargs=2, type=float, required=True, metavar=("LO", "HI"),
                    help="the spin parameter's range, in its own unit (LO >= 0)")
     add_points(s, 200, "spin values (default: 200)")
@@ -33,31 +33,18 @@ def register(sub) -> None:
     s.set_defaults(run=run)
 
 
-def _default_spin(model) -> str:
-    from gyro.analyses.spin import sets_spin
-    from gyro.errors import ParameterError
-
-    declared = [p.name for p in model.params if sets_spin(model, p.name)]
-    rates = declared or [p.name for p in model.params if p.unit == "rad/s"]
-    if len(rates) == 1:
-        return rates[0]
-    raise ParameterError(f"--spin: name the parameter that sets the spin ({model.name} has "
-                         + (f"several candidates: {' '.join(rates)})" if rates else "no parameter in rad/s)"))
-
-
 def run(args) -> int:
     import numpy as np
 
     from gyro.analyses.harmonic import require_inputs, unbalance_response
+    from gyro.analyses.spin import spin_parameter
     from gyro.errors import ParameterError
     from gyro.models import load
 
     model = load(args.model)
     require_inputs(model)
     values = model.parameters(parse_sets(args.set))
-    spin = args.spin or _default_spin(model)
-    if spin not in model.param_names:
-        raise ParameterError(f"--spin {spin!r}: unknown parameter; known: {' '.join(model.param_names)}")
+    spin = spin_parameter(model, args.spin, sole_rate=True)
     lo, hi = args.spin_range
     if not (math.isfinite(lo) and math.isfinite(hi)) or lo < 0 or not lo < hi:
         raise ParameterError(f"--spin-range: need finite 0 <= LO < HI, got {lo} {hi}")

@@ -91,6 +91,12 @@ def _se_list(xs):
     return [se.sympify(x) for x in xs]
 
 
+def jacobian(exprs, wrt) -> sp.Matrix:
+    """The matrix d exprs_i / d wrt_j, differentiated in SymEngine, as SymPy."""
+    xs = _se_list(wrt)
+    return sp.Matrix([[_sp(_se(e).diff(x)) for x in xs] for e in exprs])
+
+
 TIME = sp.Symbol("t")  # explicit time (derive.model.TIME)
 _TIME_SE = se.Symbol("t")
 

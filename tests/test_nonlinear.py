@@ -82,6 +82,7 @@ def test_nonlinear_small_oscillation_has_the_linear_frequency(mode):
     from scipy.integrate import solve_ivp
     from scipy.optimize import brentq
 
+    from gyro import ode
     from gyro.ladder import natural_frequencies
 
     values = MODEL.parameters()
@@ -105,13 +106,7 @@ def test_nonlinear_small_oscillation_has_the_linear_frequency(mode):
         qd0[coords.index(name)] = (lam * x[i]).real
     k = coords.index("gamma3")
     qd0[k] = values["H"] / values["C"] - _spin_axis_rate(values, q0, qd0, coords)
-    nf = MODEL.numpy
-    zero3 = np.zeros(3)
-
-    def rhs(_, y):
-        q, qd = y[:11], y[11:]
-        return np.concatenate([qd, np.linalg.solve(nf.mass_matrix(P, q), nf.forcing(P, q, qd, zero3, zero3))])
-
+    rhs = ode.numpy_rhs(MODEL, P)  # the emitted CasADi equations, no given forces
     T = 3 * 2 * np.pi / w
     sol = solve_ivp(rhs, (0, T), np.concatenate([q0, qd0]), method="DOP853", rtol=1e-11, atol=1e-18,
                     dense_output=True)

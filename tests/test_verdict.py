@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from gyro.analyses import gyrohorizoncompass as ghc
+from gyro.methods import reference
 from gyro.results import Spectrum, classify, verdict
 from tests.conftest import run_cli
 
@@ -123,21 +124,14 @@ def _exact_eigenvalues(v: dict):
     with mpmath.workdps(40):
         p = [mpmath.mpf(v[k].numerator) / v[k].denominator for k in NAMES]
         eps0 = mf.relative_equilibrium(p)[0][0]
-        M, D, K = mf.operator(p, [0, 0, 0, eps0])
-        A = mpmath.zeros(8, 8)
-        for i in range(4):
-            A[i, 4 + i] = 1
-        X, Y = -(M**-1) * K, -(M**-1) * D
-        for i in range(4):
-            for j in range(4):
-                A[4 + i, j], A[4 + i, 4 + j] = X[i, j], Y[i, j]
+        A = reference.companion(*mf.operator(p, [0, 0, 0, eps0]))
         w = mpmath.eig(A, left=False, right=False)
         return np.array([complex(x) for x in w]), np.array(A.tolist(), dtype=float)
 
 
 @pytest.mark.parametrize("case", ["random", "on the row chi = 0.32", "just off the row"])
 def test_every_exact_eigenvalue_lies_in_a_disk(case):
-    """The radii of eigen_radii: every exact eigenvalue (40 digits) lies within the radius of
+    """The radii of gyro.qep.eigen_radii: every exact eigenvalue (40 digits) lies within the radius of
     a computed one, and the computed companion matrix errs by less than n u ||A||_F (the
     share eigen_radii allows the inputs and M, D, K)."""
     rng = np.random.default_rng(3)

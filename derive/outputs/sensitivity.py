@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import sympy as sp
 
+from derive import mechanics
 from derive.model import Function
 
 ORDER = 25
@@ -23,8 +24,8 @@ def functions(d) -> list[Function]:
         # vanishes, and SymPy's would carry DiracDelta and unevaluated Derivatives: no
         # emitted sensitivities (the runtime's CasADi route differentiates away from kinks)
         return []
-    dJ = sp.Matrix([[sp.diff(e, w) for w in wrt] for e in entries])
-    dr = d.equilibrium_residual.jacobian(wrt)
+    dJ = mechanics.jacobian(entries, wrt)
+    dr = mechanics.jacobian(list(d.equilibrium_residual), wrt)
     names = ", ".join(str(w) for w in wrt)
     return [Function("operator_sensitivity", d.state(),
                      [("dMDK", dJ), ("dr", dr)],

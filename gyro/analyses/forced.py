@@ -191,8 +191,8 @@ def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12
     from scipy.integrate import solve_ivp
     from scipy.linalg import expm
 
+    from gyro import ode
     from gyro.equilibrium import equilibrium
-    from gyro.kernels import function
 
     _check_model(model)
     s, k, a, phi = harmonic
@@ -211,8 +211,14 @@ def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12
     q_ref = np.zeros(len(coords))
     for name, v in zip(model.meta["equilibrium_coordinates"], qe):
         q_ref[coords.index(name)] = v
-    mass, force = function(model, "mass_matrix"), function(model, "forcing")
-    zero3 = np.zeros((1, 3))
+    zero3 = np.zeros(3)
+
+    def given(t):
+        F = np.zeros(3)
+        F[s - 1] = a * np.sin(w * t + phi)
+        return F, zero3
+
+    rhs = ode.numpy_rhs(model, P, given)
 
     def full(z):
         q = q_ref.copy()
@@ -222,14 +228,6 @@ def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12
         g, gd = dict(zip(coords, q)), dict(zip(coords, qd))
         qd[k3] = values["H"] / values["C"] - _spin_free_rate(values, g, gd)
         return np.concatenate([q, qd])
-
-    def rhs(t, y):
-        q, qd = y[:11], y[11:]
-        F = np.zeros((1, 3))
-        F[0, s - 1] = a * np.sin(w * t + phi)
-        Mq = mass(P[None], q[None])[0][0]
-        f = force(P[None], q[None], qd[None], F, zero3)[0][0]
-        return np.concatenate([qd, np.linalg.solve(Mq, f)])
 
     def period(z):
         sol = solve_ivp(rhs, (0.0, T), full(z), method="DOP853", rtol=rtol, atol=1e-30, dense_output=True)

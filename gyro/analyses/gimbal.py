@@ -497,18 +497,6 @@ CASADI_METHODS = ("cvodes", "idas")
 METHODS = ("closed_form", *SCIPY_METHODS, *CASADI_METHODS)
 
 
-def _casadi_ode(P: np.ndarray):
-    """The generated CasADi mass matrix and forcing as an explicit ODE y' = F(y), y = (q, qd)."""
-    import casadi as ca
-
-    cf = load(MODEL).casadi
-    y = ca.SX.sym("y", 6)
-    q, qd = y[:3], y[3:]
-    Mq = cf.mass_matrix(P, q)
-    f = cf.forcing(P, q, qd)
-    return y, ca.vertcat(qd, ca.solve(Mq, f))
-
-
 class IntegrationBudget(RuntimeError):
     """An integrator stopped by its budget (a runaway on stiff or extreme input)."""
 
@@ -518,21 +506,25 @@ BUDGET_STEPS = 2 * 10**6  # and its steps (right-hand sides for SciPy, internal 
 
 
 def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, atol: float = 1e-12,
-              budget_s: float = BUDGET_SECONDS, budget_steps: int = BUDGET_STEPS):
+              budget_s: float | None = None, budget_steps: int = BUDGET_STEPS):
     """Integrate the generated equations (1.1) (any C0) in psi, theta, phi from the motion's
     initial state; returns (q, qd) at the times t (arrays len(t) x 3). A run that needs
-    more than `budget_s` seconds or `budget_steps` steps stops with IntegrationBudget,
-    saying how far it got."""
+    more than `budget_steps` steps, or more than `budget_s` seconds where one is given (the
+    command line's BUDGET_SECONDS), stops with IntegrationBudget, saying how far it got.
+    A library call has no wall-time budget: how long a run takes depends on the machine's
+    load, how far it gets must not."""
     import time
 
     t = np.asarray(t, float)
     P = param_vector(motion.params)
     y0 = np.concatenate([motion.q0, motion.qd0])
+    budget_s = math.inf if budget_s is None else budget_s
     if method in SCIPY_METHODS:
         from scipy.integrate import solve_ivp
 
-        nf = load(MODEL).numpy
+        from gyro import ode
 
+        fun = ode.numpy_rhs(load(MODEL), P)
         start, calls = time.perf_counter(), [0]
 
         def rhs(tt, y):
@@ -540,7 +532,7 @@ def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, at
             if calls[0] % 1000 == 0 and (calls[0] > budget_steps or time.perf_counter() - start > budget_s):
                 raise IntegrationBudget(f"{method} stopped at t = {tt:.6g} s of {t[-1]:.6g} s after "
                                         f"{calls[0]} evaluations, {time.perf_counter() - start:.0f} s (its budget)")
-            return np.concatenate([y[3:], np.linalg.solve(nf.mass_matrix(P, y[:3]), nf.forcing(P, y[:3], y[3:]))])
+            return fun(tt, y)
 
         sol = solve_ivp(rhs, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol)
         if not sol.success:
@@ -549,7 +541,10 @@ def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, at
     elif method in CASADI_METHODS:
         import casadi as ca
 
-        y, ydot = _casadi_ode(P)
+        from gyro import ode
+
+        sym = ode.symbolic(load(MODEL))
+        y, ydot = sym.y, ca.substitute(sym.ydot, sym.p, ca.DM(P))
         opts = {"abstol": atol, "reltol": rtol, "max_num_steps": budget_steps,
                 "disable_internal_warnings": True}  # SUNDIALS' own lines on stderr: the error says it
         F = ca.integrator("F", method, {"x": y, "ode": ydot}, t[0], t, opts)
@@ -641,7 +636,7 @@ def trajectory(motion: Motion, t, method: str = "closed_form"):
         psi, phi = cf.psi_phi(t)
         theta, kind, period = cf.theta(t), cf.motion_type, cf.period
     else:
-        q, _ = integrate(motion, t, method, RTOL, ATOL)
+        q, _ = integrate(motion, t, method, RTOL, ATOL, budget_s=BUDGET_SECONDS)
         theta, psi, phi = q[:, 1], q[:, 0], q[:, 2]
     return Trajectory(MODEL, model.meta["title"], method, t, theta, psi, phi,
                       motion.integrals0, kind, period)
@@ -669,6 +664,6 @@ def motion_answer(motion: Motion, t, method: str = "closed_form", rtol: float = 
         n = (t[-1] - t[0]) / cf.period if math.isfinite(cf.period) else math.inf
         est = eps * (16 * (1 + n) + 4 / math.sqrt(max(cf.m1, 1e-300)))
         return q, np.full(3, est * max(1.0, float(np.max(np.abs(q)))))
-    q1, _ = integrate(motion, t, method, rtol, rtol * 1e-2)
-    q2, _ = integrate(motion, t, method, rtol * 1e-2, rtol * 1e-4)
+    q1, _ = integrate(motion, t, method, rtol, rtol * 1e-2, budget_s=BUDGET_SECONDS)
+    q2, _ = integrate(motion, t, method, rtol * 1e-2, rtol * 1e-4, budget_s=BUDGET_SECONDS)
     return q2, 2 * np.max(np.abs(q1 - q2), axis=0)

@@ -11,7 +11,7 @@ The spectrum: the eigenvalues of the companion matrix [[0, I], [-M^-1 K, -M^-1 D
 emitted operator at (0, 0, 0, epsilon0) (LAPACK, balanced; gyro.qep.companion_matrix). The
 ladder's default method assumes gyroscopic blocks with K > 0, which fails exactly where this
 module looks (gyroscopic stabilisation, K indefinite), so the companion eigensolve is used
-throughout. Each eigenvalue carries an error radius (`eigen_radii`: its condition number
+throughout. Each eigenvalue carries an error radius (`gyro.qep.eigen_radii`: its condition number
 times a bound on the rounding of the companion matrix), and each condition's margin a
 rounding bound (the emitted `condition_rounding`); the verdicts are read through
 gyro.results.verdict: 'unstable' where a root's disk lies right of the axis, 'boundary'
@@ -33,13 +33,14 @@ from gyro.equilibrium import operators
 from gyro.errors import finite_number, grid_axis
 from gyro.kernels import function
 from gyro.models import ParameterError, load
+from gyro import qep
 from gyro.qep import companion_matrix
 from gyro.results import verdict
 
 MODEL = "gyrohorizoncompass"
 NAMES = ("A", "B", "C", "J", "L", "I", "nu", "zeta", "eta", "lambda")
 DERIVED = ("theta", "chi")  # map axes besides the parameters
-U = 2.0**-53  # the unit roundoff of double precision
+U = qep.UNIT_ROUNDOFF  # the unit roundoff of double precision
 BOUNDARY, MARGINAL = -1, -2  # condition_map's values besides 2, 1, 0
 LAMBDA_TOL = 1e-12  # lambda = 1 + chi to this relative tolerance when eta != 0
 
@@ -162,7 +163,7 @@ def analyse(P: np.ndarray, orbit: np.ndarray | bool = False) -> dict:
         ok &= np.all(np.isfinite(A), axis=(1, 2))
         eig = np.full((n, 8), np.nan + 0j)
         radius = np.full((n, 8), np.inf)
-        eig[ok], radius[ok] = eigen_radii(A[ok], Mc[ok])
+        eig[ok], radius[ok] = qep.eigen_radii(A[ok], Mc[ok])
         bounds = [U * np.asarray(x).reshape(n, -1) for x in function(m, "condition_rounding")(P)]
     lam = P[:, 9]
     exact = np.abs(lam - (1 + tc[:, 1])) <= LAMBDA_TOL * np.maximum(1.0, np.abs(1 + tc[:, 1]))
@@ -230,35 +231,6 @@ def analyse(P: np.ndarray, orbit: np.ndarray | bool = False) -> dict:
             "spectrum_verdict": spec, "verdict": verdict.make(label, reason),
             "boundary": label == "boundary",
             "spectrally_stable": stable, "growth": growth, "B1": B1, "C1": C1, "residual": resid}
-
-
-def eigen_radii(A: np.ndarray, M: np.ndarray):
-    """Eigenvalues of a batch of companion matrices A (sets, 2n, 2n) and a radius each that
-    bounds its distance to the exact eigenvalue at the decimal inputs: n_A kappa_i ||E||_2,
-    with kappa_i = ||x_i|| ||y_i|| / |y_i^H x_i| (right and left eigenvectors; the rows of
-    X^-1 are the left ones) and ||E||_2 <= ||E||_F <= u ||A||_F (2 n_A + 3 n_A cond_2(M)):
-    n_A for the rounding of the inputs and of M, D, K (measured: at most 2.4 u ||A||_F
-    against 40 digits, tests/test_verdict.py), n_A for LAPACK's QR iteration (backward
-    error p(n) u ||A||, p(n) ~ n), 3 n_A cond(M) for the two solves with M (LU, growth 1 for
-    M > 0). The factor n_A: every eigenvalue of A + E lies in a disk of radius
-    n_A kappa_i ||E||_2 about some lambda_i (a Bauer-Fike theorem with individual condition
-    numbers, Demmel 1997, Thm 4.5), not only to first order. A defective eigenvalue has
-    kappa = inf: its radius is infinite. docs/gyrohorizoncompass.md, "Boundaries"."""
-    nA = A.shape[-1]
-    with np.errstate(all="ignore"):
-        w, X = np.linalg.eig(A)
-        kappa = np.full(w.shape, np.inf)
-        try:
-            kappa[:] = np.linalg.norm(X, axis=1) * np.linalg.norm(np.linalg.inv(X), axis=2)
-        except np.linalg.LinAlgError:  # an exactly singular X somewhere: set by set
-            for k in range(len(A)):
-                try:
-                    kappa[k] = np.linalg.norm(X[k], axis=0) * np.linalg.norm(np.linalg.inv(X[k]), axis=1)
-                except np.linalg.LinAlgError:
-                    continue
-        E = U * np.linalg.norm(A, axis=(1, 2)) * (2 * nA + 3 * nA * np.linalg.cond(M))
-        radius = nA * np.where(np.isfinite(kappa), kappa, np.inf) * E[:, None]
-    return w, np.where(np.isfinite(radius), radius, np.inf)
 
 
 def free_coordinate(K: np.ndarray) -> np.ndarray:
@@ -399,11 +371,12 @@ def _casadi_rhs():
     """y' = F(y, P), y = (q, q'), from the emitted CasADi mass matrix and forcing; and E(y, P)."""
     import casadi as ca
 
-    cf = model().casadi
-    y, p = ca.SX.sym("y", 8), ca.SX.sym("p", 10)
-    ydot = ca.vertcat(y[4:], ca.solve(cf.mass_matrix(p, y[:4]), cf.forcing(p, y[:4], y[4:])))
-    E = cf.first_integral(p, y[:4], y[4:])[0]
-    return ca, y, p, ydot, E
+    from gyro import ode
+
+    s = ode.symbolic(model())
+    y, p = s.y, s.p
+    E = model().casadi.first_integral(p, y[:4], y[4:])[0]
+    return ca, y, p, s.ydot, E
 
 
 def projected_stepper(P: np.ndarray, h: float, n: int, iterations: int = 2):

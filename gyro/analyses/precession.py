@@ -79,8 +79,11 @@ def _integrator(level: str, n_out: int, rtol_scale: float = 1.0):
     P = ca.SX.sym("P", npar + 1)  # parameters and the horizon T
     p, T = P[:npar], P[npar]
     if level == "full":
-        y = ca.SX.sym("y", 6)
-        rhs = ca.vertcat(y[3:], ca.solve(cf.mass_matrix(p, y[:3]), cf.forcing(p, y[:3], y[3:])))
+        from gyro import ode
+
+        s = ode.symbolic(load(MODEL))
+        y = s.y
+        rhs = ca.substitute(s.ydot, s.p, p)
     else:
         y = ca.SX.sym("y", 3)
         A, b = getattr(cf, f"{level}_system")(p, y[:2], y[2])

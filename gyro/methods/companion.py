@@ -1,31 +1,30 @@
 """``companion``: eigenvalues of the balanced first-order (companion) matrix by LAPACK.
-The estimate is eps ||A|| / |lambda| (Bauer-Fike for a well-conditioned root)."""
+The estimate is each root's condition number (right and left eigenvectors) times the
+backward error of forming and solving the first-order problem, over |lambda|: it holds on
+damped, non-normal operators, where eps ||A|| / |lambda| does not (gyro.qep.eigen_radii)."""
 from __future__ import annotations
 
 import numpy as np
 
 from gyro import qep
-from gyro.equilibrium import equilibria, operators, tame
+from gyro.equilibrium import equilibria, operators
 from gyro.models import Model
 from gyro.results import Spectrum
 
 NAME = "companion"
 RUNG = 3  # place on the ladder of accuracy (docs/methods.md)
-COST = 5.8e-5  # s per set on one core (bench/results/ladder.json): the relative cost
+COST = 1.2e-4  # s per set on one core: twice the eigenvalues-only 5.8e-5 of bench/results/ladder.json (measured side by side; the eigenvectors give the condition numbers)
 
 
 def solve(model: Model, P: np.ndarray, tol: float | None = None) -> Spectrum:
-    """Eigenvalues of the balanced companion matrix of each set (LAPACK), one per pair."""
+    """Eigenvalues of the balanced companion matrix of each set (LAPACK), one per pair,
+    each with its condition number's estimate (gyro.qep.companion_roots)."""
     qe, ok = equilibria(model, P)
     M, D, K = operators(model, P, qe)
     n = M.shape[-1]
-    A = qep.companion_matrix(M, D, K)
-    good = ok & tame(A)
     lam = np.full((P.shape[0], n), np.nan + 0j)
-    if good.any():
-        lam[good] = qep.pairs(np.linalg.eigvals(A[good]), n)
-    # LAPACK balances A (D A D^-1) before its backward-stable QR iteration
-    norm = np.linalg.norm(A, ord=1, axis=(1, 2))
-    est = 2 * n * qep.EPS * norm[:, None] / np.abs(lam)
+    est = np.full((P.shape[0], n), np.inf)
+    if ok.any():
+        lam[ok], est[ok] = qep.companion_roots(M[ok], D[ok], K[ok])
     f, g, e = qep.sort_spectrum(np.abs(lam.imag), lam.real, est)
     return Spectrum("companion", f, g, e, qe)

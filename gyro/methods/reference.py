@@ -31,10 +31,9 @@ def _mp_equilibrium(mf, p, q0, idx, max_iter=60):
     raise EquilibriumError("Newton's method in extended precision did not converge")
 
 
-def _reference_roots(mf, p, start, idx):
-    """One set in the working precision: (roots, their last Newton steps relative, q)."""
-    q = _mp_equilibrium(mf, p, start, idx)
-    M, D, K = mf.operator(p, q)
+def companion(M, D, K):
+    """The first-order matrix [[0, I], [-M^-1 K, -M^-1 D]] of mpmath matrices, in the
+    working precision (gyro.qep.companion_matrix's, in mpmath)."""
     n = M.rows
     Minv = mpmath.inverse(M)
     A = mpmath.zeros(2 * n, 2 * n)
@@ -43,7 +42,15 @@ def _reference_roots(mf, p, start, idx):
         A[i, n + i] = 1
         for j in range(n):
             A[n + i, j], A[n + i, n + j] = B[i, j], C[i, j]
-    lams = mpmath.eig(A, left=False, right=False)
+    return A
+
+
+def _reference_roots(mf, p, start, idx):
+    """One set in the working precision: (roots, their last Newton steps relative, q)."""
+    q = _mp_equilibrium(mf, p, start, idx)
+    M, D, K = mf.operator(p, q)
+    n = M.rows
+    lams = mpmath.eig(companion(M, D, K), left=False, right=False)
     lam_c = np.array([complex(v) for v in lams])
     roots, steps = [], []
     for r in qep.representatives(lam_c, n):

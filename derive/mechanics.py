@@ -544,5 +544,7 @@ def root_series(F, x, x0, eps, order: int) -> list:
         ck = sp.expand(G.coeff(eps, k).subs(out))
         a = ck.coeff(cs[k - 1])
         out[cs[k - 1]] = -(ck - a * cs[k - 1]) / a
-    values = {f: sp.diff(F, x, i, eps, j).subs({x: x0, eps: 0}) for (i, j), f in Fs.items()}
+    Fse, xse, ese = _se(F), _se(x), _se(eps)
+    at = {xse: _se(x0), ese: se.Integer(0)}
+    values = {f: _sp(Fse.diff(*([xse] * i + [ese] * j)).subs(at)) for (i, j), f in Fs.items()}
     return [out[c].subs(values) for c in cs]

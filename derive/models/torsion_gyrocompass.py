@@ -324,8 +324,8 @@ def _grouped(expr):
     omega_y^2, omega_0^2, m_c, l_c, a) and collected by powers of Omega, omega_y^2 and
     omega_0^2: the same value with a quarter of the operations (for emission)."""
     W, wy2, w02, mc, lc, a_ = sp.symbols("W_ wy2_ w02_ mc_ lc_ a_", positive=True)
-    e = sp.factor(sp.cancel(expr.subs({H: W * A, Kgamma: wy2 * A, K0: w02 * m})))
-    e = sp.factor(sp.cancel(e.subs({M: mc - m}).subs({l1: (mc * lc - m * l2) / (mc - m)})))
+    e = sp.cancel(expr.subs({H: W * A, Kgamma: wy2 * A, K0: w02 * m}))  # canonical p/q: the next cancel's
+    e = sp.factor(sp.cancel(e.subs({M: mc - m}).subs({l1: (mc * lc - m * l2) / (mc - m)})))  # input form is moot
     num, den = sp.fraction(e)
     num = sp.collect(sp.expand(num.subs(I3, (a_ - 1) * A)), [W, wy2, w02], func=sp.factor)
     back = {W: H / A, wy2: Kgamma / A, w02: K0 / m, mc: m_c, lc: l_c, a_: (A + I3) / A}

@@ -267,3 +267,15 @@ def test_a_tolerance_past_every_level_exits_1_saying_so():
     for its 4 coordinates: the torsion gyrocompass's would take seconds)."""
     rc, out, err = run_cli("scene", "gyrohorizoncompass", "frequencies", "--tol", "1e-40")
     assert rc == 1 and "can promise" in err and len(err.strip().splitlines()) == 1 and out == ""
+
+
+def test_a_divergent_real_pair_is_no_neighbour_of_the_slow_mode():
+    """The gyrohorizoncompass's illustrative set diverges (a real pair, frequency 0, growth
+    0.10 rad/s) and its spectrum ranks that root by |lambda|, between omega1 = 9.4e-4 and
+    omega3 = 2.1 rad/s. Neighbours are taken in frequency: the 0 does not touch omega1's
+    interval, and the question is answered (it was refused as 'modes 1 and 2 within their
+    bounds of each other')."""
+    rc, out, err = run_cli("scene", "gyrohorizoncompass", "frequencies", "--tol", "0.1", "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    assert d["level"] == "linear_exact:default" and 0.0 in d["frequencies"]

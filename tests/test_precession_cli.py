@@ -148,3 +148,9 @@ def test_a_parameter_typed_by_its_alias_is_the_same_parameter():
         assert model.canonical(alias) == symbol and model.canonical(symbol) == symbol
         assert model.parameters({alias: value})[symbol] == value
         assert model.vector({alias: value})[model.param_names.index(symbol)] == value
+
+
+def test_an_unknown_level_lists_each_known_one_once(tmp_path):
+    rc, _, err = run_cli("level-map", "gimbal_precession", "--level", "nosuch", "--against", "small",
+                         "--x", "k_xi1=0:1e-4:2", "--y", "l_x=5e-4:1e-3:2", "--out", str(tmp_path / "m.png"))
+    assert rc == 2 and err.strip().endswith("known: elementary, small, rigorous, image, full"), err

@@ -30,7 +30,8 @@ def question_of(model, level: str, against: str, question: str | None = None) ->
     known = hierarchy.levels(model)
     if not known:
         raise ParameterError(f"level-map: {model.name} declares no levels")
-    names = [lv.name for lv in known] + sorted({lv.family for lv in known if lv.family})
+    names = [lv.name for lv in known]  # and a family's name (linear_exact) where it is not a level's own
+    names += sorted({lv.family for lv in known if lv.family} - set(names))
     for flag, name in (("--level", level), ("--against", against)):
         if name not in names:
             raise ParameterError(f"{flag}: unknown level {name!r} of {model.name}; known: {', '.join(names)}")

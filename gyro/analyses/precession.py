@@ -30,7 +30,7 @@ MODEL = "gimbal_precession"
 LEVELS = ("full", "rigorous", "image", "small", "elementary")  # most exact first
 SINGULAR_COS = 1e-3  # |cos beta| (or |cos alpha|) below this: at the singularity (|angle| > 89.94 deg)
 RTOL, ATOL = 1e-12, 1e-14
-MAX_STEPS = 2 * 10**6  # full, between two output times: its nutation at H/J rad/s sets the step
+MAX_STEPS = 2 * 10**6  # full, over the horizon: its nutation at H/J rad/s sets the step
 MAX_STEPS_PRECESSION = 10**4  # between two output times (CVODES counts per output interval); the precession
 # levels take a few hundred for an hour at rtol 1e-12, so more means the singularity at beta = +-90 deg
 
@@ -89,7 +89,10 @@ def _integrator(level: str, n_out: int, rtol_scale: float = 1.0):
         A, b = getattr(cf, f"{level}_system")(p, y[:2], y[2])
         rhs = ca.solve(A, b)
     grid = list(np.linspace(0.0, 1.0, n_out))
-    steps = MAX_STEPS if level == "full" else MAX_STEPS_PRECESSION
+    # full: MAX_STEPS over the whole horizon, shared among the output intervals (CVODES
+    # counts per interval), so a runaway horizon stops after as many steps however many
+    # points are asked for
+    steps = max(500, MAX_STEPS // max(1, n_out - 1)) if level == "full" else MAX_STEPS_PRECESSION
     opts = {"abstol": ATOL * rtol_scale, "reltol": RTOL * rtol_scale, "max_num_steps": steps, "linear_multistep_method": "adams",
             "nonlinear_solver_iteration": "functional", "disable_internal_warnings": True}
     return ca.integrator(f"F_{level}", "cvodes", {"x": y, "p": P, "ode": T * rhs}, 0.0, grid, opts)

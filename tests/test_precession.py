@@ -221,3 +221,17 @@ def test_declared_costs_are_the_benchs():
     assert gp.PRECESSION_COST == pytest.approx(float(np.median(prec)), rel=0.05)
     assert min(prec) > gp.PRECESSION_COST / 2 and max(prec) < 2 * gp.PRECESSION_COST
     assert gp.COSTS["full"] == pytest.approx(c["full"], rel=0.05)
+
+
+def test_a_step_budget_far_from_the_singularity_is_a_numerical_limit(monkeypatch):
+    """CVODES stopped by its step budget with beta and alpha far from +-90 deg is a numerical
+    limit (IntegrationBudget, exit 1), not bad input: with the budget at 5 steps between
+    outputs, the balanced gyroscope's slow drift over 100 s stops by it; near +-90 deg the
+    same stop is the singularity (the test above)."""
+    monkeypatch.setattr(pr, "MAX_STEPS_PRECESSION", 5)
+    pr._integrator.cache_clear()
+    try:
+        with pytest.raises(pr.IntegrationBudget, match="step budget"):
+            pr.simulate(pr.parameters({"l_x": 1e-4}), np.linspace(0, 100, 3), "rigorous")
+    finally:
+        pr._integrator.cache_clear()

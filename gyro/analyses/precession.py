@@ -122,9 +122,57 @@ def initial_state(level: str, values: dict) -> np.ndarray:
     return np.array([x0, y0, H0])
 
 
+class IntegrationBudget(RuntimeError):
+    """A level's integration stopped by its step budget away from the singularity (the
+    horizon is too long for it): a numerical limit, exit 1 at the command line."""
+
+
+NEAR_SINGULAR_COS = 0.05  # |cos| of beta or alpha at the last state reached: on the way to +-90 deg
+
+
+def _why_stopped(level: str, P, y0, T: float, rtol_scale: float = 1.0) -> Exception:
+    """Why CVODES stopped before T: the motion is integrated again over doubling horizons
+    T 2^-40, T 2^-39, ..., T (one output each, restarting from the state reached: the
+    levels are autonomous) until one fails, and for the precession levels on from there by
+    halved steps (60 tries); the last state reached says whether beta or alpha was on the
+    way to +-90 deg (Singular, bad input for the level) or not (the step budget:
+    IntegrationBudget)."""
+    nf = load(MODEL).numpy
+    F = _integrator(level, 2, rtol_scale)
+    y, reached, step = np.asarray(y0, float), 0.0, 0.0
+    for k in range(41):
+        target = T * 2.0 ** (k - 40)
+        try:
+            y = np.array(F(x0=y, p=np.append(P, target - reached))["xf"])[:, -1]
+        except RuntimeError:
+            step = target - reached
+            break
+        reached = target
+    if level != "full":  # cheap levels: closer to where it stops, advancing by halved steps
+        for _ in range(60):
+            step /= 2
+            try:
+                y = np.array(F(x0=y, p=np.append(P, step))["xf"])[:, -1]
+                reached += step
+                step *= 2
+            except RuntimeError:
+                continue
+    if level in ("full", "rigorous"):
+        alpha, beta = y[0], y[1]
+    else:
+        alpha, beta = nf.angles_of_image(P, [y[0], y[1]])
+    if not (np.isfinite(alpha) and np.isfinite(beta)) or min(abs(np.cos(alpha)), abs(np.cos(beta))) < NEAR_SINGULAR_COS:
+        return Singular(f"{level}: the integration stopped near t = {reached:.6g} s of {T:.6g} s with beta or alpha "
+                        "near +-90 deg, where (13) is singular")
+    return IntegrationBudget(f"{level}: the integration stopped by its step budget near t = {reached:.6g} s of "
+                             f"{T:.6g} s, beta {np.degrees(beta):.3g} deg and alpha {np.degrees(alpha):.3g} deg there, "
+                             "not at +-90 deg; a shorter --t-end")
+
+
 def simulate(values: dict, t, level: str, rtol_scale: float = 1.0):
     """The motion of one level at the times t (t[0] = 0): ImagePointMotion. Singular when it
-    reaches beta or alpha = +-90 deg; FloatingPointError when the integrator fails."""
+    reaches beta or alpha = +-90 deg; IntegrationBudget when the integrator stops by its
+    step budget elsewhere."""
     from gyro.results import ImagePointMotion
 
     if level not in LEVELS:
@@ -138,11 +186,8 @@ def simulate(values: dict, t, level: str, rtol_scale: float = 1.0):
     c0 = time.process_time()
     try:
         Y = np.array(F(x0=y0, p=np.append(P, T))["xf"]).T
-    except RuntimeError as exc:
-        if level != "full" or "MXSTEP" in str(exc).upper():
-            raise Singular(f"{level}: the integration stopped before t = {T:.6g} s (beta or alpha near +-90 deg, "
-                           "where (13) is singular, or the step budget)") from None
-        raise FloatingPointError(f"{level}: CVODES failed before t = {T:.6g} s") from None
+    except RuntimeError:
+        raise _why_stopped(level, P, y0, T, rtol_scale) from None
     seconds = time.process_time() - c0
     Y = np.vstack([y0, Y]) if len(t) != Y.shape[0] else Y
     if level in ("full", "rigorous"):

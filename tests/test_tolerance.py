@@ -36,7 +36,9 @@ def test_first_order_against_sampling(study):
     se = study.sampling_error()
     assert np.all(np.abs(study.first_order_std / study.std - 1) <= 4 * se)
     assert np.all(np.abs(study.mean - study.nominal) <= 4 * study.std / np.sqrt(N))
-    assert study.first_order_holds().all() and study.failed == 0
+    # at N = 2048 three standard errors are 4.7 %: first order cannot be shown within 5 %
+    # here, but nothing says it fails
+    assert not np.any(study.first_order_verdict() == "fails") and study.failed == 0
     q = study.quantiles
     assert np.all((q[:, 0] < q[:, 1]) & (q[:, 1] < q[:, 2]))
 
@@ -142,3 +144,22 @@ def test_cli_contract(tg, tmp_path):
         args = ["tolerance", MODEL, *bad] + ([] if "--samples" in bad else ["--samples", "10"])
         rc, text, err = run_cli(*args)
         assert rc == 2 and what in err and len(err.strip().splitlines()) == 1 and text == "", (bad, err)
+
+
+def test_the_first_order_verdict_is_three_way(study):
+    """holds / fails only where three standard errors of sampling leave no doubt about the
+    5 % criterion; undecided between; none without a first order. With N = 2048 samples and
+    kurtosis 3 the margin is 3 sqrt(2 / 4N) = 4.7 %: a difference of 0.1 % holds, 20 %
+    fails, 5 % is undecided (it was called 'holds', within 5 % + the margin)."""
+    from dataclasses import replace
+
+    n = len(study.nominal)
+    err = np.full(n, 0.001)
+    err[1], err[2], err[3] = 0.2, 0.05, np.nan
+    s = replace(study, std=np.ones(n), first_order_std=1 + err, kurtosis=np.full(n, 3.0), failed=0, samples=2048)
+    v = s.first_order_verdict()
+    assert list(v[:4]) == ["holds", "fails", "undecided", "none"] and set(v[4:]) == {"holds"}
+    doc = s.to_dict()["frequencies"]
+    assert [(f["first_order"], f["first_order_holds"]) for f in doc[:4]] == \
+        [("holds", True), ("fails", False), ("undecided", None), ("none", None)]
+    assert "undecided (+5.0 %)" in s.table().splitlines()[5]

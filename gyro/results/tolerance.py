@@ -57,16 +57,29 @@ class ToleranceStudy:
         with np.errstate(invalid="ignore", divide="ignore"):
             return self.first_order_std / self.std - 1
 
+    def first_order_verdict(self) -> np.ndarray:
+        """Per mode: 'holds' where the first-order std is within HOLDS of the sampled one with
+        three standard errors of sampling to spare, 'fails' where it is beyond HOLDS by more
+        than three of them (a difference sampling cannot explain: a nonlinearity first order
+        misses), 'undecided' where the samples are too few to say (the sampling error
+        admits both), 'none' where there is no first order (a double root)."""
+        err, se = np.abs(self.first_order_error()), 3 * self.sampling_error()
+        out = np.full(err.shape, "none", object)
+        ok = np.isfinite(err) & np.isfinite(se)
+        out[ok] = "undecided"
+        out[ok & (err + se <= HOLDS)] = "holds"
+        out[ok & (err - se > HOLDS)] = "fails"
+        return out
+
     def first_order_holds(self) -> np.ndarray:
-        """Per mode: first order within HOLDS of the sampled std, beyond three standard
-        errors of sampling (a difference sampling cannot explain, larger than 5 %, is a
-        nonlinearity first order misses)."""
-        err = np.abs(self.first_order_error())
-        return err <= HOLDS + 3 * self.sampling_error()
+        """Per mode: True where first order holds, False where it fails, None where the
+        samples cannot say or there is no first order (first_order_verdict)."""
+        v = self.first_order_verdict()
+        return np.array([True if x == "holds" else False if x == "fails" else None for x in v], object)
 
     def to_dict(self) -> dict:
         """The `gyro tolerance --json` document (its keys are the contract)."""
-        holds = self.first_order_holds()
+        holds, verdict = self.first_order_holds(), self.first_order_verdict()
         err, se = self.first_order_error(), self.sampling_error()
         modes = []
         for i in range(len(self.nominal)):
@@ -74,7 +87,7 @@ class ToleranceStudy:
                           "quantiles": {str(q): _num(v) for q, v in zip(QUANTILE_LEVELS, self.quantiles[i])},
                           "first_order_std": _num(self.first_order_std[i]),
                           "first_order_error": _num(err[i]), "std_sampling_error": _num(se[i]),
-                          "first_order_holds": bool(holds[i]) if np.isfinite(err[i]) else None,
+                          "first_order_holds": holds[i], "first_order": verdict[i],
                           "skewness": _num(self.skewness[i])})
         doc = {"model": self.model, "samples": self.samples, "seed": self.seed, "method": self.method,
                "spreads": self.spreads, "correlations": self.correlations, "frequencies": modes,
@@ -94,10 +107,10 @@ class ToleranceStudy:
                  "spreads: " + ", ".join(f"{s['name']} {s['kind']} {100 * s['width']:g} %" for s in self.spreads),
                  f"{'':>4} {'nominal':>12} {'mean':>12} {'std':>11} {'1st-order std':>13} {'q 0.01':>12} "
                  f"{'q 0.99':>12}  first order"]
-        holds, err = self.first_order_holds(), self.first_order_error()
+        verdicts, err = self.first_order_verdict(), self.first_order_error()
         for i in range(len(self.nominal)):
             if np.isfinite(self.first_order_std[i]):
-                verdict = ("holds" if holds[i] else "fails") + (f" ({100 * err[i]:+.1f} %)" if np.isfinite(err[i]) else "")
+                verdict = str(verdicts[i]) + (f" ({100 * err[i]:+.1f} %)" if np.isfinite(err[i]) else "")
             else:
                 verdict = "none (a double root at the nominal set)"
             lines.append(f"{i + 1:>4} {self.nominal[i]:>12.6g} {self.mean[i]:>12.6g} {self.std[i]:>11.4g} "

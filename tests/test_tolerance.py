@@ -163,3 +163,17 @@ def test_the_first_order_verdict_is_three_way(study):
     assert [(f["first_order"], f["first_order_holds"]) for f in doc[:4]] == \
         [("holds", True), ("fails", False), ("undecided", None), ("none", None)]
     assert "undecided (+5.0 %)" in s.table().splitlines()[5]
+
+
+def test_a_band_probability_with_failed_samples_says_its_range(tg):
+    """With failed samples (negative stiffnesses of a 40 % spread) the sampled band
+    probability is conditional on the answered ones; over all samples it lies in
+    probability_range, from none of the failed in the band to all of them."""
+    s = tolerance(tg, tg.defaults, [parse_spread("Kp=normal:0.4"), parse_spread("K0=normal:0.4")], 2000, seed=2,
+                  harmonics=(1,), band=0.02)
+    assert s.failed > 0
+    for row in s.to_dict()["band_probability"]:
+        b = row[0]
+        lo, hi = b["probability_range"]
+        assert lo == pytest.approx(b["probability"] * s.answered / s.samples) and hi == pytest.approx(lo + s.failed / s.samples)
+    assert f"of the {s.answered} answered samples" in s.table()

@@ -275,7 +275,11 @@ def _bands(F, ok, spin, harmonics, band, nominal_freq, dfreq, model, nominal, co
                 mu = nominal_freq[i] - e * k * wc0
                 # no sensitivities (a double root at the nominal set): no first order, NaN
                 fo += sign * (float(ndtr(mu / s)) if s > 0 else float(mu > 0) if s == 0 else np.nan)
-            row.append({"harmonic": k, "omega": k * wc0, "probability": int(inside.sum()) / n_ok,
+            hit, n_all = int(inside.sum()), len(ok)
+            # the sampled probability is conditional on the answered samples; over all of
+            # them it lies between "no failed sample was in the band" and "every one was"
+            row.append({"harmonic": k, "omega": k * wc0, "probability": hit / n_ok,
+                        "probability_range": [hit / n_all, (hit + n_all - int(ok.sum())) / n_all],
                         "first_order_probability": fo})
         out.append(row)
     return out

@@ -130,6 +130,9 @@ class ToleranceStudy:
                     shown += 1
             if not shown:
                 lines.append("     none: every frequency stays clear (sampled 0, first order below 1e-6)")
+            if self.failed:
+                lines.append(f"     sampled: of the {self.answered} answered samples; over all {self.samples}, "
+                             "between the JSON's probability_range (the failed ones all out of the band, or all in)")
         return "\n".join(lines)
 
     def plot(self, out, modes=None) -> None:

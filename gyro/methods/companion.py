@@ -13,7 +13,7 @@ from gyro.results import Spectrum
 
 NAME = "companion"
 RUNG = 3  # place on the ladder of accuracy (docs/methods.md)
-COST = 1.2e-4  # s per set on one core: twice the eigenvalues-only 5.8e-5 of bench/results/ladder.json (measured side by side; the eigenvectors give the condition numbers)
+COST = 1.5e-4  # s per set on one core: 2.6x the eigenvalues-only 5.8e-5 of bench/results/ladder.json (side by side, 2.4x..5.8x under load: balancing set by set and the eigenvectors for the condition numbers)
 
 
 def solve(model: Model, P: np.ndarray, tol: float | None = None) -> Spectrum:

@@ -84,19 +84,7 @@ def compile_c(model: str, tmp: Path) -> ctypes.CDLL:
     return ctypes.CDLL(str(lib))
 
 
-_DERIVED = {}
-
-
-def derived(name: str):
-    """(model, derivation, functions by name) of any model, derived once per session."""
-    if name not in _DERIVED:
-        import importlib
-        import io
-
-        from derive import pipeline
-        from derive.models import MODELS
-
-        model = importlib.import_module(MODELS[name]).build()
-        d = pipeline.derive(model, pipeline.Steps(out=io.StringIO()))
-        _DERIVED[name] = (model, d, {f.name: f for f in pipeline.functions(d)})
-    return _DERIVED[name]
+# the derivations live in one module: pytest imports this file as `conftest` and the test
+# files import it again as `tests.conftest`, two module objects with a cache each, which
+# derived the torsion gyrocompass twice per process
+from tests.derivations import derived  # noqa: E402,F401

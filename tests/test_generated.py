@@ -166,37 +166,60 @@ def _compare(got, ref, what):
     return worst
 
 
+# one test per emitted function (its own random points), so that the parallel workers share
+# the largest model's functions; each worker compiles a model's C once
+FUNCTIONS = [(name, fname) for name in MODELS
+             for fname in sorted(json.loads((GENERATED / name / "metadata.json").read_text())["functions"])]
+_LIBS = {}
+
+
+@pytest.fixture(scope="session")
+def compiled(tmp_path_factory):
+    def get(name):
+        if name not in _LIBS:
+            _LIBS[name] = compile_c(name, tmp_path_factory.mktemp(f"c_{name}"))
+        return _LIBS[name]
+    return get
+
+
 @pytest.mark.parametrize("name", MODELS)
-def test_generated_code_matches_symbolic(name, tmp_path):
+def test_the_documented_functions_are_the_derived_ones(name):
+    """metadata.json lists exactly the derivation's functions, each with the derivation's
+    call order (inputs and outputs): the calls of the test below follow metadata."""
+    _, _, functions = derived(name)
+    documented = json.loads((GENERATED / name / "metadata.json").read_text())["functions"]
+    assert list(documented) == sorted(functions)
+    for fname, fn in functions.items():
+        assert [(i["name"], i["symbols"]) for i in documented[fname]["inputs"]] == \
+            [(g, [str(s) for s in syms]) for g, syms in fn.inputs], fname
+        assert [o["name"] for o in documented[fname]["outputs"]] == [o for o, _ in fn.outputs], fname
+
+
+@pytest.mark.parametrize("name, fname", FUNCTIONS, ids=[f"{n}.{f}" for n, f in FUNCTIONS])
+def test_generated_code_matches_symbolic(name, fname, compiled):
     """C (compiled with -Wall -Wextra -Werror), NumPy, CasADi and mpmath at 100 random
     points of every emitted function of every model, each entry to 1e-12 of its term scale;
     the C batch entry point over the same points gives the same bytes as the single calls."""
     model, _, functions = derived(name)
-    lib = compile_c(name, tmp_path)
-    rng = random.Random(2024)
-    documented = json.loads((GENERATED / name / "metadata.json").read_text())["functions"]
-    assert list(documented) == sorted(functions)
-    for fname, fn in functions.items():
-        # the documented call order is the derivation's: the calls below follow metadata
-        assert [(i["name"], i["symbols"]) for i in documented[fname]["inputs"]] == \
-            [(g, [str(s) for s in syms]) for g, syms in fn.inputs], fname
-        assert [o["name"] for o in documented[fname]["outputs"]] == [o for o, _ in fn.outputs], fname
-        shapes = [(mat.rows, mat.cols) for _, mat in fn.outputs]
-        points, singles = [], []
-        for k in range(N_POINTS):
-            vals = _random_inputs(fn, model, rng)
-            ref = _reference(fn, vals)
-            points.append(vals)
-            singles.append(_call_c(lib, fn, vals, name))
-            _compare(singles[-1], ref, f"C {name}.{fname}")
-            if k % 5 == 0:  # the Python backends share the printer logic: every 5th point
-                for backend, call in (("numpy", _call_numpy), ("casadi", _call_casadi),
-                                      ("mpmath", _call_mpmath)):
-                    got = [np.asarray(g, dtype=float).reshape(s) for g, s in zip(call(fn, vals, name), shapes)]
-                    _compare(got, ref, f"{backend} {name}.{fname}")
-        for one, many in zip(singles, _call_c_batch(lib, fn, points, name)):
-            for a, b in zip(one, many):
-                np.testing.assert_array_equal(a, b)
+    lib = compiled(name)
+    fn = functions[fname]
+    rng = random.Random(f"2024:{name}:{fname}")  # each function's own points, whatever runs first
+    shapes = [(mat.rows, mat.cols) for _, mat in fn.outputs]
+    points, singles = [], []
+    for k in range(N_POINTS):
+        vals = _random_inputs(fn, model, rng)
+        ref = _reference(fn, vals)
+        points.append(vals)
+        singles.append(_call_c(lib, fn, vals, name))
+        _compare(singles[-1], ref, f"C {name}.{fname}")
+        if k % 5 == 0:  # the Python backends share the printer logic: every 5th point
+            for backend, call in (("numpy", _call_numpy), ("casadi", _call_casadi),
+                                  ("mpmath", _call_mpmath)):
+                got = [np.asarray(g, dtype=float).reshape(s) for g, s in zip(call(fn, vals, name), shapes)]
+                _compare(got, ref, f"{backend} {name}.{fname}")
+    for one, many in zip(singles, _call_c_batch(lib, fn, points, name)):
+        for a, b in zip(one, many):
+            np.testing.assert_array_equal(a, b)
 
 
 def test_numpy_functions_broadcast_over_a_batch(tg_model):

@@ -189,8 +189,12 @@ def model_key(path: Path, root: Path) -> str:
     machinery = sorted(p for p in (root / "derive").rglob("*.py") if "__pycache__" not in p.parts)
     machinery += sorted(p for p in (root / "templates").iterdir() if p.is_file())
     for p in own + machinery:
+        try:
+            data = p.read_bytes()
+        except FileNotFoundError:  # removed since the listing (an editor's or a test's temporary file)
+            continue
         h.update(str(p.relative_to(root) if p.is_relative_to(root) else p).encode() + b"\0")
-        h.update(p.read_bytes() + b"\0")
+        h.update(data + b"\0")
     for dist in ("sympy", "symengine"):
         try:
             h.update(f"{dist}={version(dist)}".encode())

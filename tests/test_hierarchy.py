@@ -271,11 +271,12 @@ def test_a_tolerance_past_every_level_exits_1_saying_so():
 
 def test_a_divergent_real_pair_is_no_neighbour_of_the_slow_mode():
     """The gyrohorizoncompass's illustrative set diverges (a real pair, frequency 0, growth
-    0.10 rad/s) and its spectrum ranks that root by |lambda|, between omega1 = 9.4e-4 and
-    omega3 = 2.1 rad/s. Neighbours are taken in frequency: the 0 does not touch omega1's
-    interval, and the question is answered (it was refused as 'modes 1 and 2 within their
-    bounds of each other')."""
+    0.10 rad/s), and its spectrum ranks that root by |lambda|, between omega = 9.4e-4 and
+    2.1 rad/s. The question answers in ascending frequency (the 0 first), neighbours are
+    neighbours in frequency, and the 0 does not touch 9.4e-4's interval: answered (it was
+    refused as 'modes 1 and 2 within their bounds of each other')."""
     rc, out, err = run_cli("scene", "gyrohorizoncompass", "frequencies", "--tol", "0.1", "--json")
     assert rc == 0, err
     d = json.loads(out)
-    assert d["level"] == "linear_exact:default" and 0.0 in d["frequencies"]
+    assert d["level"] == "linear_exact:default" and d["frequencies"][0] == 0.0
+    assert d["frequencies"] == sorted(d["frequencies"])

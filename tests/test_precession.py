@@ -231,7 +231,19 @@ def test_a_step_budget_far_from_the_singularity_is_a_numerical_limit(monkeypatch
     monkeypatch.setattr(pr, "MAX_STEPS_PRECESSION", 5)
     pr._integrator.cache_clear()
     try:
-        with pytest.raises(pr.IntegrationBudget, match="step budget"):
+        with pytest.raises(pr.IntegrationBudget, match="step budget") as exc:
             pr.simulate(pr.parameters({"l_x": 1e-4}), np.linspace(0, 100, 3), "rigorous")
+        import re
+
+        near = re.search(r"near t = ([0-9.e+-]+) s of", str(exc.value))
+        assert near is None or float(near.group(1)) <= 100  # never a state beyond the horizon
+        for budget, T in ((16, 1000.0), (25, 3000.0)):  # the review's cases: past T, and 'Singular' there
+            monkeypatch.setattr(pr, "MAX_STEPS_PRECESSION", budget)
+            pr._integrator.cache_clear()
+            try:
+                pr.simulate(pr.parameters({"l_x": 1e-4}), np.linspace(0, T, 3), "rigorous")
+            except pr.IntegrationBudget as e:
+                near = re.search(r"near t = ([0-9.e+-]+) s of", str(e))
+                assert near is None or float(near.group(1)) <= T, str(e)
     finally:
         pr._integrator.cache_clear()

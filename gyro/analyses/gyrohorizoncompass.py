@@ -439,7 +439,9 @@ def integrate(values: dict, y0: np.ndarray, t: np.ndarray, method: str = "DOP853
     if method in CASADI_METHODS:
         ca, y, p, ydot, _ = _casadi_rhs()
         ode = ca.substitute(ydot, p, ca.DM(P))
-        per = max(500, max_steps // max(1, len(t) - 1))  # SUNDIALS counts steps between output times
+        # SUNDIALS counts steps between output times; no budget (a library call): SUNDIALS' own
+        # ceiling (inf // k is NaN, and max(500, NaN) was 500 steps an interval)
+        per = 10**9 if math.isinf(max_steps) else max(500, max_steps // max(1, len(t) - 1))
         opts = {"abstol": atol, "reltol": rtol, "max_num_steps": int(min(per, 10**9)),
                 "disable_internal_warnings": True}  # SUNDIALS' own lines on stderr: the error says it
         if method == "cvodes-adams":  # non-stiff: Adams-Moulton with fixed-point iteration

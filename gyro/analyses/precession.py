@@ -148,9 +148,14 @@ def _why_stopped(level: str, P, y0, T: float, rtol_scale: float = 1.0) -> Except
             step = target - reached
             break
         reached = target
-    if level != "full":  # cheap levels: closer to where it stops, advancing by halved steps
+    if reached >= T:  # the whole horizon in pieces: the run's own budget per output interval was short
+        return IntegrationBudget(f"{level}: the integration stopped by its step budget between two output "
+                                 f"times before t = {T:.6g} s (fewer --points take more steps each)")
+    if level != "full":  # cheap levels: closer to where it stops, advancing by halved steps, never past T
         for _ in range(60):
-            step /= 2
+            step = min(step / 2, T - reached)
+            if step <= 0:
+                break
             try:
                 y = np.array(F(x0=y, p=np.append(P, step))["xf"])[:, -1]
                 reached += step

@@ -36,14 +36,23 @@ def requested(model, opts) -> list[int]:
     return sorted({m - 1 for m in modes})
 
 
+def _ascending(f, e, g):
+    """The answer in the question's order, ascending by frequency (NaN last; ties, as the
+    real roots of a divergent set, in the spectrum's order): a spectrum comes ranked by
+    |lambda|, which puts a divergent pair (frequency 0) above a slow oscillation."""
+    order = np.argsort(np.where(np.isnan(f), np.inf, f), axis=1, kind="stable")
+    take = lambda a: np.take_along_axis(a, order, axis=1)  # noqa: E731
+    return take(f), take(e), take(g)
+
+
 def _spectrum(model, level, P):
     from gyro import ladder
 
     spec = ladder.spectrum(model, P, level.evaluator["method"])
-    f, e = spec.frequencies, spec.error_estimate
+    f, e, g = _ascending(spec.frequencies, spec.error_estimate, spec.growth)
     failed = np.full(f.shape[0], "", object)
     failed[~np.all(np.isfinite(f), axis=1)] = "a frequency could not be computed"
-    return Answer(f, e, failed, {"growth": spec.growth})
+    return Answer(f, e, failed, {"growth": g})
 
 
 def _poly_roots(c: np.ndarray):
@@ -86,9 +95,7 @@ def _charpoly(model, level, P):
     # a frequency's relative error is half that of its z; an exact zero root (a free
     # direction, as the neutral azimuth at u = 0) has no relative error to give
     est = np.where(z == 0, np.inf, est / 2)
-    order = np.argsort(np.abs(growth + 1j * freq), axis=1)
-    take = lambda a: np.take_along_axis(a, order, axis=1)  # noqa: E731
-    f, g, e = take(freq), take(growth), take(est)
+    f, e, g = _ascending(freq, est, growth)
     e = np.where(np.isfinite(e) & (e < 0.5), e, np.inf)
     failed = np.full(f.shape[0], "", object)
     failed[~np.all(np.isfinite(f), axis=1)] = "a root could not be computed"

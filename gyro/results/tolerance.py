@@ -62,11 +62,17 @@ class ToleranceStudy:
         three standard errors of sampling to spare, 'fails' where it is beyond HOLDS by more
         than three of them (a difference sampling cannot explain: a nonlinearity first order
         misses), 'undecided' where the samples are too few to say (the sampling error
-        admits both), 'none' where there is no first order (a double root)."""
-        err, se = np.abs(self.first_order_error()), 3 * self.sampling_error()
-        out = np.full(err.shape, "none", object)
+        admits both, or there is no sampled spread to compare with), 'none' where there is no
+        first order (a double root)."""
+        r = self.first_order_error()
+        # the standard error of first_order_std / std - 1 is (1 + r) times the sampled
+        # std's relative one
+        with np.errstate(invalid="ignore"):
+            se = 3 * np.abs(1 + r) * self.sampling_error()
+        err = np.abs(r)
+        out = np.full(err.shape, "undecided", object)  # e.g. one sample, or a zero sampled std
+        out[~np.isfinite(self.first_order_std)] = "none"
         ok = np.isfinite(err) & np.isfinite(se)
-        out[ok] = "undecided"
         out[ok & (err + se <= HOLDS)] = "holds"
         out[ok & (err - se > HOLDS)] = "fails"
         return out

@@ -133,10 +133,15 @@ NEAR_SINGULAR_COS = 0.05  # |cos| of beta or alpha at the last state reached: on
 def _why_stopped(level: str, P, y0, T: float, rtol_scale: float = 1.0) -> Exception:
     """Why CVODES stopped before T: the motion is integrated again over doubling horizons
     T 2^-40, T 2^-39, ..., T (one output each, restarting from the state reached: the
-    levels are autonomous) until one fails, and for the precession levels on from there by
-    halved steps (60 tries); the last state reached says whether beta or alpha was on the
-    way to +-90 deg (Singular, bad input for the level) or not (the step budget:
-    IntegrationBudget)."""
+    levels are autonomous) until one fails, and on from there by halved steps (60 tries,
+    never past T); the last state reached says whether beta or alpha was on the way to +-90
+    deg (Singular, bad input for the level) or not (the step budget: IntegrationBudget).
+    The full level, whose pieces would each cost its whole budget again, is said to have
+    stopped by its budget or a failed step (its samples show the singularity where it
+    integrates)."""
+    if level == "full":  # its pieces would cost the whole budget again (seconds): said as it is
+        return IntegrationBudget(f"full: CVODES stopped before t = {T:.6g} s (its step budget of "
+                                 f"{MAX_STEPS:.3g} steps over the horizon, or a failed step)")
     nf = load(MODEL).numpy
     F = _integrator(level, 2, rtol_scale)
     y, reached, step = np.asarray(y0, float), 0.0, 0.0
@@ -151,18 +156,17 @@ def _why_stopped(level: str, P, y0, T: float, rtol_scale: float = 1.0) -> Except
     if reached >= T:  # the whole horizon in pieces: the run's own budget per output interval was short
         return IntegrationBudget(f"{level}: the integration stopped by its step budget between two output "
                                  f"times before t = {T:.6g} s (fewer --points take more steps each)")
-    if level != "full":  # cheap levels: closer to where it stops, advancing by halved steps, never past T
-        for _ in range(60):
-            step = min(step / 2, T - reached)
-            if step <= 0:
-                break
-            try:
-                y = np.array(F(x0=y, p=np.append(P, step))["xf"])[:, -1]
-                reached += step
-                step *= 2
-            except RuntimeError:
-                continue
-    if level in ("full", "rigorous"):
+    for _ in range(60):  # closer to where it stops, advancing by halved steps, never past T
+        step = min(step / 2, T - reached)
+        if step <= 0:
+            break
+        try:
+            y = np.array(F(x0=y, p=np.append(P, step))["xf"])[:, -1]
+            reached += step
+            step *= 2
+        except RuntimeError:
+            continue
+    if level == "rigorous":
         alpha, beta = y[0], y[1]
     else:
         alpha, beta = nf.angles_of_image(P, [y[0], y[1]])

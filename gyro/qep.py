@@ -163,8 +163,7 @@ def balanced_radii(A: np.ndarray, M: np.ndarray):
     B = np.empty_like(A)
     for k in range(len(A)):
         B[k] = sla.matrix_balance(A[k], permute=False)[0]
-    w, r = eigen_radii(B, Ms)
-    return w, r
+    return eigen_radii(B, Ms)
 
 
 def companion_roots(M, D, K):

@@ -113,30 +113,23 @@ def answer(model, level, P, opts) -> Answer:
 
 
 def edges(model, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
-    """'' per set, or the reason the bound is no promise there: two modes neighbouring in
-    frequency (among all of them) whose intervals omega (1 +- bound) touch. Neighbours in
-    frequency, not in the spectrum's order: that ranks roots by |lambda|, so a divergent real
-    pair (frequency 0, growth > 0) can stand between two oscillations, and its 0 is no
-    neighbour of the slow mode below it."""
+    """'' per set, or the reason the bound is no promise there: two neighbouring modes (in
+    rank, among all of them; answers are ascending in frequency, `_ascending`) whose
+    intervals omega (1 +- bound) touch."""
     f = ans.values
     out = np.full(f.shape[0], "", object)
-    order = np.argsort(np.where(np.isnan(f), np.inf, f), axis=1, kind="stable")
-    fs = np.take_along_axis(f, order, axis=1)
-    bs = np.take_along_axis(np.asarray(bound, float), order, axis=1)
     with np.errstate(invalid="ignore"):
-        lo, hi = fs * (1 - bs), fs * (1 + bs)
-        touch = hi[:, :-1] >= lo[:, 1:]  # neighbours j and j + 1 in frequency
+        lo, hi = f * (1 - bound), f * (1 + bound)
+        touch = hi[:, :-1] >= lo[:, 1:]  # rank j and j + 1
     want = np.zeros(f.shape[1], bool)
     want[list(idx)] = True
-    ws = want[order]
-    relevant = ws[:, :-1] | ws[:, 1:]
+    relevant = want[:-1] | want[1:]
     # a mode a level leaves unanswered (bound inf) is, by the level's declaration, one that
     # keeps its rank (the neutral azimuth at u = 0 below every other mode)
-    touch &= relevant & np.isfinite(bs[:, :-1]) & np.isfinite(bs[:, 1:])
+    touch &= relevant[None, :] & np.isfinite(bound[:, :-1]) & np.isfinite(bound[:, 1:])
     for k in np.flatnonzero(touch.any(axis=1)):
         j = int(np.flatnonzero(touch[k])[0])
-        a, b = sorted((int(order[k, j]) + 1, int(order[k, j + 1]) + 1))
-        out[k] = f"modes {a} and {b} within their bounds of each other (veering or a merged root)"
+        out[k] = f"modes {j + 1} and {j + 2} within their bounds of each other (veering or a merged root)"
     return out
 
 

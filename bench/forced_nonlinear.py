@@ -4,10 +4,12 @@ For one harmonic of the bearing imperfections, away from a resonance (f1, k = 1 
 example: omega_c = 2513 rad/s, 35 % below omega10) and near one (f3, k = 1 with H set so
 that omega_c is 1 % below the radial bearing mode omega_p = 780 rad/s), the periodic
 response of the full 11-coordinate equations (gyro.analyses.forced.nonlinear_response)
-against the linear one, on a ladder of amplitudes a, each twice the last: the first halving
-gives the order of the neglected terms, the smallest amplitude the constant c of err = c a^2,
-and the amplitude a_1% where they differ by 1 % is interpolated where the ladder crosses
-1 % and extrapolated from its top otherwise. Writes bench/results/forced_linear_limit.json:
+against the linear one, on a ladder of amplitudes a, each twice the last at first and then
+closer about 1 %, each rung started from the last one's periodic motion (continuation in a):
+the first halving gives the order of the neglected terms, the smallest amplitude the
+constant c of err = c a^2, and the amplitude a_1% where they differ by 1 % is interpolated
+(log-log) between the two measured rungs about it; a ladder that does not cross 1 % says so
+and extrapolates from its top. Writes bench/results/forced_linear_limit.json:
 the first measured boundary of the linear level (gyro.analyses.forced.LINEAR_LIMIT,
 docs/forced.md).
 """
@@ -21,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from gyro import load
-from gyro.analyses.forced import cases, linear_error, nonlinear_response
+from gyro.analyses.forced import cases, linear_error, nonlinear_response, spin_torque
 
 RESULTS = Path(__file__).resolve().parent / "results"
 # the integration's tolerance and the shooting's periodicity: the error measured is then
@@ -33,9 +35,9 @@ RTOL, PERIODIC_TOL = 1e-10, 1e-8
 def bench_cases(model):
     values = cases(model)
     return {
-        "away": {"values": values["away"][0], "harmonic": (1, 1, None, 0.0), "ladder": (100.0, 200.0, 400.0),
+        "away": {"values": values["away"][0], "harmonic": (1, 1, None, 0.0), "ladder": (100.0, 200.0, 400.0, 800.0, 1600.0, 2400.0, 3200.0),
                  "what": "f1, k = 1 at the example (omega_c = 2513 rad/s, 35 % below omega10 = 3851 rad/s)"},
-        "near": {"values": values["near"][0], "harmonic": (3, 1, None, 0.0), "ladder": (0.5, 1.0, 2.0, 4.0, 8.0, 16.0),
+        "near": {"values": values["near"][0], "harmonic": (3, 1, None, 0.0), "ladder": (0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 24.0, 32.0, 40.0, 48.0, 64.0, 96.0),
                  "what": "f3, k = 1, H = 0.99 omega_p C: omega_c 1 % below the radial bearing mode omega_p = 780 rad/s"},
     }
 
@@ -46,11 +48,19 @@ def measure(model, values, harmonic, a, start=None):
     t0 = time.perf_counter()
     Xn, Xl, info = nonlinear_response(model, values, (s, k, a, phi), rtol=RTOL, periodic_tol=PERIODIC_TOL,
                                       start=start)
+    dX = np.abs(Xn - Xl)
+    worst = max(range(len(units)), key=lambda i: dX[i] / max(np.abs(Xl)[[j for j, v in enumerate(units) if v == units[i]]]))
     row = {"a": a, "error": linear_error(Xn, Xl, units), "newton_steps": info["newton_steps"],
            "residual": info["residual"], "seconds": time.perf_counter() - t0,
+           # the coordinate that sets the error, and each coordinate's |X_nl| / |X_lin|
+           "worst_coordinate": model.meta["reduced"][worst],
+           "ratios": {c: float(abs(Xn[i]) / abs(Xl[i])) if abs(Xl[i]) > 0 else None
+                      for i, c in enumerate(model.meta["reduced"])},
            "peak_linear": {u: float(np.max(np.abs(Xl)[[i for i, v in enumerate(units) if v == u]])) for u in set(units)}}
-    print(f"  a = {a:.6g} N: error {row['error']:.5g} ({row['newton_steps']} Newton steps, "
+    print(f"  a = {a:.6g} N: error {row['error']:.5g}, set by {row['worst_coordinate']} "
+          f"({row['newton_steps']} Newton steps, "
           f"residual {row['residual']:.2g}, {row['seconds']:.1f} s)", flush=True)
+    row["z"] = info["continuation"]["z"]
     return row, info["continuation"]
 
 
@@ -59,8 +69,12 @@ def main() -> None:
     out = {"model": model.name, "rtol": RTOL, "periodic_tol": PERIODIC_TOL, "machine": platform.machine(), "cases": {}}
     for name, case in bench_cases(model).items():
         print(f"{name}: {case['what']}", flush=True)
-        # a ladder of amplitudes, each halving showing the order; each from the linear start
-        rows = [measure(model, case["values"], case["harmonic"], a)[0] for a in case["ladder"]]
+        # a ladder of amplitudes, each halving showing the order; the first rung from the
+        # linear start, each next one from the last one's periodic motion
+        rows, start = [], None
+        for a in case["ladder"]:
+            row, start = measure(model, case["values"], case["harmonic"], a, start)
+            rows.append(row)
         # the order from the first halving (the cleanest: the next order smallest there), c
         # from the smallest amplitude
         order = float(np.log2(rows[1]["error"] / rows[0]["error"]))
@@ -71,13 +85,32 @@ def main() -> None:
             i = int(np.argmax(errs >= 0.01))
             p = np.log(errs[i] / errs[i - 1]) / np.log(amps[i] / amps[i - 1])
             limit, how = float(amps[i - 1] * (0.01 / errs[i - 1]) ** (1 / p)), "interpolated between measured amplitudes"
+            bracket = [float(amps[i - 1]), float(amps[i])]
         else:  # extrapolated along the local order of the last two points
             p = np.log(errs[-1] / errs[-2]) / np.log(amps[-1] / amps[-2])
             limit, how = float(amps[-1] * (0.01 / errs[-1]) ** (1 / p)), "extrapolated from the largest amplitude measured"
+            bracket = None
+        # at the limit itself: the error there (the interpolation's check) and what the
+        # left-out torque on the spin would change (gyro.analyses.forced.spin_torque)
+        below = max((r for r in rows if r["a"] <= limit), key=lambda r: r["a"], default=None)
+        Xn, Xl, info = nonlinear_response(model, case["values"], (case["harmonic"][0], case["harmonic"][1], limit,
+                                                                  case["harmonic"][3]),
+                                          rtol=RTOL, periodic_tol=PERIODIC_TOL,
+                                          start=None if below is None else {"z": below["z"], "a": below["a"]})
+        units = [model.meta["coordinate_units"][c] for c in model.meta["reduced"]]
+        at_limit = {"a": limit, "error": linear_error(Xn, Xl, units),
+                    "spin_torque": spin_torque(model, case["values"], (case["harmonic"][0], case["harmonic"][1],
+                                                                       limit, case["harmonic"][3]), info)}
+        print(f"  at a_1%: error {at_limit['error']:.5g}; the left-out spin torque: momentum swing "
+              f"{at_limit['spin_torque']['momentum_swing']:.3g} of H, effect ~{at_limit['spin_torque']['effect_estimate']:.2g}",
+              flush=True)
+        for r in rows:
+            r.pop("z")
         out["cases"][name] = {"what": case["what"], "values": case["values"],
                               "harmonic": {"s": case["harmonic"][0], "k": case["harmonic"][1], "phase": case["harmonic"][3]},
                               "order": order, "c": c, "a_1percent": limit, "a_1percent_is": how,
-                              "largest_measured": rows[-1]["a"], "error_at_largest": rows[-1]["error"],
+                              "a_1percent_between": bracket,
+                              "largest_measured": rows[-1]["a"], "error_at_largest": rows[-1]["error"], "at_limit": at_limit,
                               "runs": rows}
         print(f"  order {order:.4f}; c = {c:.5g} N^-2; a_1% = {limit:.4g} N ({how})", flush=True)
     RESULTS.mkdir(exist_ok=True)

@@ -78,3 +78,40 @@ def numpy_rhs(model: Model, P, inputs=None):
         return np.asarray(F(y, Pd, *extra)).ravel()
 
     return fun
+
+
+def variational(model: Model):
+    """The compiled CasADi Function var(y, Phi, p, *inputs) -> (y', (dy'/dy) Phi) of a model
+    (cached per model): the equations of motion with their variational equations, whose
+    solution from Phi(0) = I is the state transition matrix (for a periodic forcing over
+    one period, the monodromy matrix)."""
+    key = _key(model, "variational")
+    if key not in _CACHE:
+        import casadi as ca
+
+        s = symbolic(model)
+        n = s.y.numel()
+        Phi = ca.SX.sym("Phi", n, n)
+        _CACHE[key] = ca.Function("variational", [s.y, Phi, s.p, *s.inputs],
+                                  [s.ydot, ca.jacobian(s.ydot, s.y) @ Phi])
+    return _CACHE[key]
+
+
+def numpy_variational(model: Model, P, inputs=None):
+    """(t, Y) -> Y' for solve_ivp on Y = (y, Phi column-major): the equations of motion at
+    fixed parameters P with their variational equations (`variational`), the forcing's
+    further inputs a function of t as in `numpy_rhs`. Returns (fun, n), n the state's size."""
+    import casadi as ca
+
+    F = variational(model)
+    Pd = ca.DM(np.asarray(P, float))
+    s = symbolic(model)
+    n = s.y.numel()
+    zeros = tuple(np.zeros(v.numel()) for v in s.inputs)
+
+    def fun(t, Y):
+        extra = zeros if inputs is None else inputs(t)
+        yd, phid = F(Y[:n], Y[n:].reshape(n, n, order="F"), Pd, *extra)
+        return np.concatenate([np.asarray(yd).ravel(), np.asarray(phid).ravel(order="F")])
+
+    return fun, n

@@ -136,13 +136,14 @@ LIMIT_FILE = Path(__file__).resolve().parents[2] / "bench" / "results" / "forced
 # The amplitude a (N) of one imperfection harmonic at which the linear response differs
 # from the periodic response of the full nonlinear equations by 1 % (linear_error), the
 # constant c (N^-2) of err = c a^2 below it and the measured order: the first measured
-# boundary of the linear level, per case of `cases` ('away': 2.4e3 N, extrapolated from
-# 400 N where err = 2.7e-4; 'near': 21.5 N, extrapolated from 16 N where err = 0.76 %).
-# From the committed run of bench/forced_nonlinear.py (bench/results/forced_linear_limit.json;
-# tests/test_forced.py holds the two equal); docs/forced.md gives the evidence.
+# boundary of the linear level, per case of `cases` ('away': 2457 N, measured between 2400 N,
+# err 0.96 %, and 3200 N, err 1.66 %; 'near': 37.0 N, between 32 N, 0.98 %, and 40 N,
+# 1.01 %). From the committed run of bench/forced_nonlinear.py
+# (bench/results/forced_linear_limit.json; tests/test_forced.py holds the two equal and
+# brackets each limit); docs/forced.md gives the evidence.
 LINEAR_LIMIT = {
-    "away": {"c": 1.7076756036344526e-09, "order": 1.999773621600764, "a_1percent": 2422.720301222084},
-    "near": {"c": 0.0001022772870722193, "order": 1.9912632144662672, "a_1percent": 21.52497736166718},
+    "away": {"c": 1.7076600899985916e-09, "order": 1.999783159796706, "a_1percent": 2457.0259498829155},
+    "near": {"c": 0.00010236321184811247, "order": 1.9897657567117946, "a_1percent": 37.03701980726426},
 }
 
 
@@ -171,25 +172,32 @@ def _spin_free_rate(values: dict, g: dict, gd: dict) -> float:
     return float((R.T @ (p + gd["gamma1"] * np.array([0, 0, 1.0])) + gd["gamma2"] * np.array([1.0, 0, 0]))[1])
 
 
-def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12, max_newton: int = 60,
-                       periodic_tol: float | None = None, start: dict | None = None):
+def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12, max_newton: int = 12,
+                       periodic_tol: float | None = None, start: dict | None = None, halvings: int = 6):
     """The steady (periodic) response of the full 11-coordinate equations (the emitted
     `mass_matrix` and `forcing`) to one harmonic f_s = a sin(k omega_c t + phi), the
     imperfection an explicit function of time (its derivative in gamma3, a torque on the
-    spin that a drive absorbs, left out: the spin keeps its integral C r2 = H).
+    spin that a drive absorbs, left out: the spin keeps its integral C r2 = H; `spin_torque`
+    measures what that leaves out).
 
     gamma3 is cyclic, so the forced equations are periodic in t with T = 2 pi/(k omega_c):
     the periodic motion is found by shooting over one period (DOP853 at rtol), Newton's
-    correction with the linear operator's monodromy (exact for the linear part) and
-    Broyden's updates for the nonlinear rest.
+    method on the periodicity z(T) - z = 0 with its exact Jacobian, the monodromy matrix
+    of the variational equations integrated beside the motion (`gyro.ode.variational`):
+    the near-neutral azimuth mode (1 - e^{i omega1 T} ~ 3e-5) makes the periodicity
+    ill-conditioned in its direction, where any approximate Jacobian (the linear operator's
+    monodromy, Broyden's updates) stalls as the amplitude grows.
     Returns (X_nonlinear, X_linear, info): the first Fourier coefficients of the reduced
     coordinates over the period (x = Re(X e^{i w t}) + harmonics and offset) and the linear
     response, info the Newton steps and the final periodicity residual (at most
-    periodic_tol of the state's scale, default 10 rtol), and `continuation`: the periodic
-    state, which `start` takes to begin a larger amplitude from this one's answer scaled to
-    it (continuation in a)."""
+    periodic_tol of the state's scale, default 10 rtol), `motion` (t -> the 11 coordinates
+    and their rates over the period) and `continuation`: the periodic state, which `start`
+    takes to begin a larger amplitude from this one's answer scaled to it (continuation in
+    a). Where Newton from the start does not converge (its residual grows, or max_newton
+    steps pass), the response at a/2 is found first and continued from (up to `halvings`
+    times; info's `continued_from` lists the amplitudes climbed): from the linear start
+    Newton leaves the basin above about 1e3 N away from resonance."""
     from scipy.integrate import solve_ivp
-    from scipy.linalg import expm
 
     from gyro import ode
     from gyro.equilibrium import equilibrium
@@ -207,8 +215,9 @@ def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12
     X_lin = harmonic_response(model, P, w, u, qe=qe[None]).X[0]
     coords, reduced = model.meta["coordinates"], model.meta["reduced"]
     ri = np.array([coords.index(c) for c in reduced])
+    nq, n = len(coords), len(ri)
     k3 = coords.index("gamma3")
-    q_ref = np.zeros(len(coords))
+    q_ref = np.zeros(nq)
     for name, v in zip(model.meta["equilibrium_coordinates"], qe):
         q_ref[coords.index(name)] = v
     zero3 = np.zeros(3)
@@ -218,69 +227,154 @@ def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12
         F[s - 1] = a * np.sin(w * t + phi)
         return F, zero3
 
-    rhs = ode.numpy_rhs(model, P, given)
+    fun, ny = ode.numpy_variational(model, P, given)
+    # the motion to rtol of itself; the transition matrix, whose entries are O(1) per unit
+    # of the state they come from (O(T) for a rate's), to 1e-3 rtol absolutely (a relative
+    # control alone would chase its structural zeros)
+    atol = np.concatenate([np.full(ny, 1e-30), np.full(ny * ny, 1e-3 * rtol)])
+    rows = np.concatenate([ri, nq + ri])
 
     def full(z):
         q = q_ref.copy()
-        q[ri] += z[:len(ri)]
-        qd = np.zeros(len(coords))
-        qd[ri] = z[len(ri):]
+        q[ri] += z[:n]
+        qd = np.zeros(nq)
+        qd[ri] = z[n:]
         g, gd = dict(zip(coords, q)), dict(zip(coords, qd))
         qd[k3] = values["H"] / values["C"] - _spin_free_rate(values, g, gd)
         return np.concatenate([q, qd])
 
+    def full_jacobian(z):
+        """d full / dz: the identity on z's entries, and gamma3's rate from the integral, an
+        analytic function of z, by central differences (accurate to ~1e-10 of itself)."""
+        Jf = np.zeros((ny, 2 * n))
+        Jf[rows, np.arange(2 * n)] = 1.0
+        for j in range(2 * n):
+            h = 1e-6 * max(abs(z[j]), 1e-9 if j < n else 1e-9 * w)
+            e = np.zeros(2 * n)
+            e[j] = h
+            Jf[nq + k3, j] = (full(z + e)[nq + k3] - full(z - e)[nq + k3]) / (2 * h)
+        return Jf
+
     def period(z):
-        sol = solve_ivp(rhs, (0.0, T), full(z), method="DOP853", rtol=rtol, atol=1e-30, dense_output=True)
+        Y0 = np.concatenate([full(z), np.eye(ny).ravel(order="F")])
+        sol = solve_ivp(fun, (0.0, T), Y0, method="DOP853", rtol=rtol, atol=atol, dense_output=True)
         if not sol.success:
             raise RuntimeError(f"integration failed: {sol.message}")
-        yT = sol.y[:, -1]
-        zT = np.concatenate([yT[ri] - q_ref[ri], yT[11 + ri]])
-        return zT, sol
+        YT = sol.y[:, -1]
+        zT = np.concatenate([YT[ri] - q_ref[ri], YT[nq + ri]])
+        monodromy = YT[ny:].reshape(ny, ny, order="F")[rows] @ full_jacobian(z)
+        return zT, monodromy, sol
 
-    M, D, K = (x[0] for x in operators(model, P[None], qe[None]))
-    n = len(ri)
-    Minv = np.linalg.inv(M)
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ D]])
-    J = expm(A * T) - np.eye(2 * n)
     z = np.concatenate([X_lin.real, (1j * w * X_lin).real])
     if start is not None:  # continuation: the previous amplitude's periodic state, scaled
         z = start["z"] * (a / start["a"])
     scale = np.concatenate([np.abs(X_lin), w * np.abs(X_lin)]) + 1e-300
-    # Newton on the periodicity R(z) = z(T) - z, its Jacobian started from the linear
-    # operator's monodromy and corrected by Broyden's rank-one updates: the near-neutral
-    # azimuth mode (1 - e^{i omega1 T} ~ 3e-5) makes the linear Jacobian's error in its
-    # direction matter, which the updates learn. A step that the integrator cannot follow
-    # is shortened. Periodic to 10 rtol of the state's scale.
-    steps, resid = 0, np.inf
-    zT, last = period(z)
-    R = zT - z
-    for steps in range(1, max_newton + 1):
+    tol = 10 * rtol if periodic_tol is None else periodic_tol
+    # Newton on R(z) = z(T) - z with the exact Jacobian; a step the integrator cannot follow
+    # is shortened. Periodic to tol of the state's scale.
+
+    def newton(z):
+        zT, Phi, sol = period(z)
+        R = zT - z
         resid = float(np.max(np.abs(R)) / scale.max())
-        if resid <= (10 * rtol if periodic_tol is None else periodic_tol):
-            break
-        dz = np.linalg.solve(J, -R)
-        for _ in range(6):
-            try:
-                zT, sol_new = period(z + dz)
-                break
-            except RuntimeError:
-                dz = dz / 4
-        else:
-            raise RuntimeError("no periodic response: the shooting's steps leave the integrator's reach")
-        z = z + dz
-        last = sol_new
-        R_new = zT - z
-        J += np.outer(R_new - R - J @ dz, dz) / (dz @ dz)
-        R = R_new
-    else:
-        raise RuntimeError(f"no periodic response within {max_newton} Newton steps (residual {resid:.2g})")
-    sol = last
+        steps, grew = 0, 0
+        while resid > tol:
+            steps += 1
+            if steps > max_newton or grew >= 2:
+                raise RuntimeError(f"no periodic response within {steps - 1} Newton steps (residual {resid:.2g})")
+            dz = np.linalg.solve(Phi - np.eye(2 * n), -R)
+            for _ in range(6):
+                try:
+                    zT, Phi_new, sol_new = period(z + dz)
+                    break
+                except RuntimeError:
+                    dz = dz / 4
+            else:
+                raise RuntimeError("no periodic response: the shooting's steps leave the integrator's reach")
+            z, Phi, sol = z + dz, Phi_new, sol_new
+            R = zT - z
+            last, resid = resid, float(np.max(np.abs(R)) / scale.max())
+            grew = grew + 1 if resid > last else 0
+        return z, sol, steps, resid
+
+    climbed: list = []
+    try:
+        z, sol, steps, resid = newton(z)
+    except RuntimeError:
+        if halvings <= 0:
+            raise
+        half = nonlinear_response(model, values, (s, k, a / 2, phi), rtol, max_newton, periodic_tol,
+                                  start if start is not None and abs(start["a"]) < abs(a) / 2 else None,
+                                  halvings - 1)[2]
+        climbed = half["continued_from"] + [a / 2]
+        z, sol, steps, resid = newton(half["continuation"]["z"] * 2)
     N = 64
     t = np.arange(N) * T / N
     x = sol.sol(t)[ri] - q_ref[ri, None]
     X_nl = 2 / N * (x * np.exp(-1j * w * t)[None, :]).sum(axis=1)
     return X_nl, X_lin, {"newton_steps": steps, "residual": resid, "frequency": w, "period": T,
-                         "continuation": {"z": z, "J": J, "a": a}}
+                         "motion": lambda tt: sol.sol(tt)[:ny], "q_ref": q_ref, "continued_from": climbed,
+                         "continuation": {"z": z, "a": a}}
+
+
+def spin_torque(model: Model, values: dict, harmonic, info: dict, samples: int = 256) -> dict:
+    """What the nonlinear check leaves out, measured on its periodic motion: the
+    imperfection's derivative in gamma3, a torque on the spin tau = dU/dgamma3 (the emitted
+    `forcing`'s gamma3 row with the given functions' derivatives in gamma3, less without
+    them), which a drive absorbs there. Without the drive it would change the spin's
+    momentum H by the integral of tau: `torque_mean` (N m, its mean over the period: a drive
+    must supply it, or the spin drifts by torque_mean / H per second, `drift_per_second`),
+    `momentum_swing` (the largest |delta H| / H of its periodic part) and
+    `effect_estimate`, momentum_swing times the linear response's relative sensitivity to H
+    at the forcing frequency (the error metric of `linear_error` per unit relative change
+    of H): the order of the change it would make in the amplitudes compared with the
+    linear ones, against their measured difference."""
+    import casadi as ca
+
+    s, k, a, phi = harmonic
+    P = model.vector(values)
+    vals = model.parameters(values)
+    coords = model.meta["coordinates"]
+    k3 = coords.index("gamma3")
+    nq = len(coords)
+    T, w = info["period"], info["frequency"]
+    t = np.arange(samples) * T / samples
+    Y = info["motion"](t)
+    f = model.casadi.forcing
+    F = np.zeros((3, samples))
+    dF = np.zeros((3, samples))
+    F[s - 1] = a * np.sin(w * t + phi)
+    dF[s - 1] = a * k * np.cos(w * t + phi)  # d f_s / d gamma3 along gamma3 = omega_c t
+    tau = np.empty(samples)
+    Pd = ca.DM(P)
+    for j in range(samples):
+        with_d = f(Pd, Y[:nq, j], Y[nq:, j], F[:, j], dF[:, j])
+        without = f(Pd, Y[:nq, j], Y[nq:, j], F[:, j], np.zeros(3))
+        tau[j] = float(with_d[k3] - without[k3])
+    mean = float(tau.mean())
+    # the periodic part of its integral, by the spectrum: delta H = sum over n != 0 of
+    # tau_n / (i n w) e^{i n w t}
+    c = np.fft.rfft(tau - mean) / samples
+    nw = np.arange(c.size) * w
+    dH = np.zeros(samples)
+    for m in range(1, c.size):
+        dH += 2 * (c[m] / (1j * nw[m]) * np.exp(1j * nw[m] * t)).real
+    H = vals["H"]
+    swing = float(np.max(np.abs(dH)) / H)
+    # the linear response's relative sensitivity to H at the fixed forcing frequency
+    from gyro.equilibrium import equilibrium
+    units = [model.meta["coordinate_units"][c] for c in model.meta["reduced"]]
+    u = np.zeros(3, complex)
+    u[s - 1] = -1j * a * np.exp(1j * phi)
+    eps = 1e-6
+    X = []
+    for sign in (-1, 1):
+        Pi = model.vector({**values, "H": H * (1 + sign * eps)})
+        X.append(harmonic_response(model, Pi, w, u, qe=equilibrium(model, Pi)[None]).X[0])
+    X0 = harmonic_response(model, P, w, u, qe=equilibrium(model, P)[None]).X[0]
+    sens = linear_error(X0 + (X[1] - X[0]) / (2 * eps), X0, units)
+    return {"torque_mean": mean, "drift_per_second": mean / H, "momentum_swing": swing,
+            "sensitivity_to_H": sens, "effect_estimate": swing * sens}
 
 
 def linear_error(X_nl: np.ndarray, X_lin: np.ndarray, units: list) -> float:

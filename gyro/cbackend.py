@@ -157,16 +157,20 @@ def _build(cc: str, src: Path, out: Path, key: str) -> None:
 
 class BatchFunction:
     """A generated function over a batch: f(*inputs) with inputs of shape (n, len_i)
-    (broadcast from one set), returning outputs of shape (n,) + output shape."""
+    (broadcast from one set), returning outputs of shape (n,) + output shape, or (n, nonzeros)
+    for an output emitted as its structural nonzeros."""
 
     def __init__(self, model_name: str, fname: str):
         meta = load(model_name).meta["functions"][fname]
         self.name = fname
         # the C signature's order: metadata lists inputs and outputs in call order
         self.in_lens = [len(i["symbols"]) for i in meta["inputs"]]
-        self.out_shapes = [tuple(o["shape"]) for o in meta["outputs"]]
+        # an output emitted as its structural nonzeros is a flat vector of them (the NumPy
+        # backend's shape too), its positions in metadata.json
+        self.out_shapes = [(len(o["nonzeros"]["rows"]), 1) if "nonzeros" in o else tuple(o["shape"])
+                           for o in meta["outputs"]]
         # the NumPy backend's shapes: a column is a vector unless the model says matrix
-        self.out_vector = [o.get("vector", o["shape"][1] == 1) for o in meta["outputs"]]
+        self.out_vector = ["nonzeros" in o or o.get("vector", o["shape"][1] == 1) for o in meta["outputs"]]
         self._fn = _entry(model_name, f"{model_name}_{fname}_batch")
 
     def __call__(self, *inputs):

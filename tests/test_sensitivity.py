@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from gyro import ladder
-from gyro.analyses.sensitivity import DOUBLE, double_roots, sensitivities
+from gyro.analyses.sensitivity import DOUBLE, _emitted_positions, double_roots, sensitivities
 from gyro.methods import reference
 from gyro.models import load
 from tests.conftest import run_cli
@@ -211,8 +211,12 @@ def test_the_emitted_jacobians_numpy_and_c(tg, nominal):
     npar = len(tg.param_names)
     for P in (tg.vector(), tg.vector() * 1.03):
         qe = nominal.spectrum.equilibrium[0]  # any (p, qe) will do: the functions are evaluated, not solved
-        dJ, dr = (np.asarray(a) for a in tg.numpy.operator_sensitivity(P, qe))
+        vals, dr = (np.asarray(a) for a in tg.numpy.operator_sensitivity(P, qe))
         c = cbackend.batch_function(tg.name, "operator_sensitivity")(P[None], qe[None])
+        # dMDK is emitted as its structural nonzeros: its matrix is they at their positions
+        dJ, cJ = np.zeros((2, 3 * tg.numpy.operator(P, qe)[0].shape[0] ** 2, dr.shape[1]))
+        dJ[_emitted_positions(tg)], cJ[_emitted_positions(tg)] = vals, c[0][0]
+        c[0] = cJ[None]
         for ref, others in ((dJ, (c[0][0],)), (dr, (c[1][0],))):
             scale = np.maximum(np.max(np.abs(ref), axis=1, keepdims=True), 1e-300)
             for o in others:

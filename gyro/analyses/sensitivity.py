@@ -63,24 +63,43 @@ def _casadi_function(model: Model):
     return ca.Function("operator_sensitivity_ad", [p, q], [j.nz[:] for j in jac]), where
 
 
-def partials(model: Model, P: np.ndarray, qe: np.ndarray, route: str = "auto"):
-    """dMDK (sets, 3 n^2, params + coordinates) and dr (sets, n, params + coordinates)."""
+@lru_cache(maxsize=None)
+def _emitted_positions(model: Model):
+    """(rows, cols) of the values of the emitted dMDK, its structural nonzeros (metadata.json)."""
+    o = next(o for o in model.meta["functions"]["operator_sensitivity"]["outputs"] if o["name"] == "dMDK")
+    return np.array(o["nonzeros"]["rows"]), np.array(o["nonzeros"]["cols"])
+
+
+def sparse_partials(model: Model, P: np.ndarray, qe: np.ndarray, route: str = "auto"):
+    """(values, rows, cols, dr): the structural nonzeros of dMDK, values (sets, nonzeros) at
+    (rows, cols) of the layout of `partials`, and dr (sets, n, params + coordinates) dense.
+    The emitted route's positions are the derivation's (metadata.json), CasADi's its own
+    sparsity of the same Jacobian."""
     if route == "auto":
         route = "emitted" if has_emitted(model) else "casadi"
     if route == "emitted":
         with np.errstate(all="ignore"):
-            dJ, dr = function(model, "operator_sensitivity")(P, qe)
-        return dJ, dr
+            vals, dr = function(model, "operator_sensitivity")(P, qe)
+        return (vals, *_emitted_positions(model), dr)
     if route != "casadi":
         raise ValueError(f"route: 'auto', 'emitted' or 'casadi', got {route!r}")
     N = P.shape[0]
     f, where = _casadi_function(model)
-    out = []
-    for nz, (rows, cols, shape) in zip(f.map(N)(P.T, qe.T), where):
-        a = np.zeros((N,) + shape)
-        a[:, rows, cols] = np.asarray(nz).T
-        out.append(a)
-    return out
+    nz_J, nz_r = f.map(N)(P.T, qe.T)
+    (rows, cols, _), (r_rows, r_cols, r_shape) = where
+    dr = np.zeros((N,) + r_shape)
+    dr[:, r_rows, r_cols] = np.asarray(nz_r).T
+    return np.asarray(nz_J).T, rows, cols, dr
+
+
+def partials(model: Model, P: np.ndarray, qe: np.ndarray, route: str = "auto"):
+    """dMDK (sets, 3 n^2, params + coordinates) and dr (sets, n, params + coordinates), dense."""
+    vals, rows, cols, dr = sparse_partials(model, P, qe, route)
+    n = next(o["shape"][0] for o in model.meta["functions"]["operator"]["outputs"] if o["name"] == "M")
+    shape = (3 * n * n, dr.shape[2])
+    dJ = np.zeros((P.shape[0],) + shape)
+    dJ[:, rows, cols] = vals
+    return dJ, dr
 
 
 def _solve_or_svd(A: np.ndarray, b: np.ndarray, halve: bool = True) -> np.ndarray:
@@ -179,13 +198,14 @@ def _chunk(model: Model, P: np.ndarray, spec: Spectrum, route: str) -> np.ndarra
     if k.size == 0:
         return out
     P, qe = P[k], qe[k]
-    dJ, dr = partials(model, P, qe, route)
+    vals, rows, cols, dr = sparse_partials(model, P, qe, route)
     M, D, K = operators(model, P, qe)
     # dq_e/dp from r(p, q_e) = 0, on the rows of the equilibrium equations
     drq, drp = dr[:, idx, npar:], dr[:, idx, :npar]
-    # only the entries of M, D, K that some set has nonzero enter the contraction
-    live = np.flatnonzero(np.any(dJ != 0, axis=(0, 2)))
-    dJ = dJ[:, live]
+    # only the entries of M, D, K with a structural nonzero enter the contraction
+    live, at = np.unique(rows, return_inverse=True)
+    dJ = np.zeros((k.size, live.size, npar + nq))
+    dJ[:, at, cols] = vals
     with np.errstate(all="ignore"):
         dq = _equilibrium_derivative(drq, drp) if nq else np.zeros((k.size, 0, npar))
         total = dJ[:, :, :npar] + dJ[:, :, npar:] @ dq  # (sets, live entries, params)

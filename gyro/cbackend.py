@@ -381,7 +381,7 @@ class SensitivityContract:
         nnz = rows.shape[0]
         _check(all(X.shape == (N, n, n) for X in (M, D)) and lam.ndim == 2 and lam.shape[0] == N
                and x.shape == y.shape == lam.shape + (n,), f"M, D (sets, {n}, {n}), lam (sets, r), x, y (sets, r, {n})")
-        _check(rows.shape == cols.shape == (nnz,) and vals.shape == (N, nnz)
+        _check(ncols >= 1 and rows.shape == cols.shape == (nnz,) and vals.shape == (N, nnz)
                and bool(np.all((rows >= 0) & (rows < 3 * n * n))) and bool(np.all((cols >= 0) & (cols < ncols))),
                f"rows in 0..{3 * n * n - 1}, cols in 0..{ncols - 1}, vals (sets, nnz)")
         h, den = np.empty(lam.shape + (ncols,), complex), np.empty(lam.shape, complex)

@@ -7,9 +7,10 @@
 3. a tolerance study of the paper's torsion gyrocompass over the bearing tolerances with
    N samples (goal: 1e7 within 10 minutes on two cores), with its figures.
 
-    python -m bench.scale [--samples N] [--sweep N] [--skip-tolerance]
+    python -m bench.scale [--samples N] [--sweep N] [--skip-tolerance] [--sensitivities-only]
 
---skip-tolerance keeps the study of the previous run (and the load it ran under).
+--skip-tolerance keeps the study of the previous run (and the load it ran under);
+--sensitivities-only measures question 1 alone, with where its time goes, and writes nothing.
 
 Writes bench/results/scale.json, tolerance_histograms.png and tolerance_tornado.png."""
 from __future__ import annotations
@@ -53,21 +54,63 @@ def bench_sensitivities(n=2000, runs=5) -> dict:
     spec = ladder.spectrum(model, P)
     sensitivities(model, P[:8], None, route="casadi")  # build CasADi's Jacobian once
     sensitivities(model, P[:8], None, route="emitted")  # and load the compiled one
-    t_f = _median_time(lambda: ladder.spectrum(model, P), runs)
-    t_e = _median_time(lambda: sensitivities(model, P, spec, route="emitted"), runs)
+    # the frequencies and the sensitivities alternate, so that a change of load weighs on both
+    t_f, t_e = (statistics.median(t) for t in zip(*[
+        (_median_time(lambda: ladder.spectrum(model, P), 1),
+         _median_time(lambda: sensitivities(model, P, spec, route="emitted"), 1)) for _ in range(runs)]))
     t_c = _median_time(lambda: sensitivities(model, P, spec, route="casadi"), max(1, runs // 2))
+    pieces = _sensitivity_pieces(model, P[:1024], _first(spec, 1024), runs)
     e = sensitivities(model, P, spec, route="emitted").d
     c = sensitivities(model, P, spec, route="casadi").d
     agree = float(np.nanmax(np.abs(e - c) / np.maximum(np.abs(e), np.nanmax(np.abs(e), axis=2, keepdims=True))))
     out = {"sets": n, "frequencies_us_per_set": 1e6 * t_f / n,
            "sensitivities_emitted_us_per_set": 1e6 * t_e / n, "sensitivities_casadi_us_per_set": 1e6 * t_c / n,
            "ratio_sensitivities_to_frequencies": t_e / t_f, "ratio_total_to_frequencies": (t_f + t_e) / t_f,
-           "casadi_over_emitted": t_c / t_e, "routes_agree_rel": agree, "goal_ratio": 3.0}
+           "casadi_over_emitted": t_c / t_e, "routes_agree_rel": agree, "goal_ratio": 3.0,
+           "pieces_us_per_set": pieces}
     print(f"sensitivities: frequencies {out['frequencies_us_per_set']:.1f} us/set, sensitivities "
           f"{out['sensitivities_emitted_us_per_set']:.1f} us/set emitted (ratio {t_e / t_f:.2f}; with the "
           f"frequencies {(t_f + t_e) / t_f:.2f}), CasADi AD {out['sensitivities_casadi_us_per_set']:.1f} us/set "
           f"({t_c / t_e:.1f}x the emitted); routes agree to {agree:.1e}", flush=True)
+    print("  per set, in one chunk of 1024: " + ", ".join(f"{k} {v:.1f} us" for k, v in pieces.items()), flush=True)
     return out
+
+
+def _first(spec, k):
+    from gyro.analyses.sensitivity import _rows
+
+    return _rows(spec, slice(0, k))
+
+
+def _sensitivity_pieces(model, P, spec, runs) -> dict:
+    """Where the time of gyro/analyses/sensitivity.py's _chunk goes, step by step on one
+    chunk (us a set, medians of `runs`): the emitted Jacobians' nonzeros, the operator, the
+    equilibrium's derivative, the null vectors and the contraction (compiled where there
+    is a compiler, as the runtime calls them)."""
+    from gyro import cbackend
+    from gyro.analyses import sensitivity as S
+    from gyro.equilibrium import operators
+    from gyro.kernels import compiled
+
+    n = P.shape[0]
+    names = model.meta["equilibrium_coordinates"]
+    idx = [model.meta["reduced"].index(c) for c in names]
+    npar, nq = len(model.param_names), len(names)
+    qe = spec.equilibrium
+    lam = spec.growth + 1j * spec.frequencies
+    null, contract = compiled(cbackend.sens_null_vectors, model), compiled(cbackend.sens_contract, model)
+    vals, rows, cols, dr = S.sparse_partials(model, P, qe, "emitted")
+    M, D, K = operators(model, P, qe)
+    herm = np.ones(n, bool)  # the bench's sets are conservative: J(i omega) Hermitian
+    x, y = S._null_vectors(M, D, K, lam, herm, null)
+    steps = {
+        "emitted Jacobians": lambda: S.sparse_partials(model, P, qe, "emitted"),
+        "operator": lambda: operators(model, P, qe),
+        "equilibrium derivative": lambda: S._equilibrium_derivative(dr[:, idx, npar:], dr[:, idx, :npar]),
+        "null vectors": lambda: S._null_vectors(M, D, K, lam, herm, null),
+        "contraction": lambda: S._contract(rows, cols, npar + nq, vals, M, D, lam, x, y, contract),
+    }
+    return {k: 1e6 * _median_time(f, runs) / n for k, f in steps.items()}
 
 
 def bench_dask(n=40000) -> dict:
@@ -127,7 +170,14 @@ def main(argv=None) -> int:
     ap.add_argument("--samples", type=int, default=10**7)
     ap.add_argument("--sweep", type=int, default=40000)
     ap.add_argument("--skip-tolerance", action="store_true")
+    ap.add_argument("--sensitivities-only", action="store_true",
+                    help="measure the sensitivities alone and print them; bench/results is not written")
     a = ap.parse_args(argv)
+    if a.sensitivities_only:
+        load0 = os.getloadavg()
+        bench_sensitivities()
+        print(f"load average at the start {load0[0]:.2f}, at the end {os.getloadavg()[0]:.2f}")
+        return 0
     RESULTS.mkdir(parents=True, exist_ok=True)
     res = {"machine": {"cpus": os.cpu_count(), "platform": platform.platform(),
                        "load_average_at_start": os.getloadavg()}}

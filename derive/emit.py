@@ -6,6 +6,9 @@ common-subexpression elimination; the same CSE is printed four ways:
 - `numpy_functions.py`: vectorised NumPy functions over a leading batch of parameter sets;
 - `mpmath_functions.py`: the same in arbitrary precision (references for tests and charts);
 - `<model>.h`, `<model>.c`: flat, allocation-free C99, each function also over a batch.
+An output that its `Function` declares sparse is emitted as its structural nonzeros alone,
+in every backend: a flat vector of values (row-major over the matrix) whose (row, column)
+positions metadata.json lists under the output's "nonzeros".
 Every file starts with a header naming the template it came from, saying it must not be
 edited, and carrying a hash of the inputs that made it (the shared machinery of `derive/`,
 the templates, the model's own file or folder and the pinned SymPy, SymEngine and CasADi
@@ -150,6 +153,19 @@ class Output:
     cols: int
     entries: list  # (flat index, printed expression) for non-zero entries, row-major
     vector: bool = False  # a column that NumPy returns with shape batch + (rows,)
+    # emitted as its structural nonzeros alone: entries[k] is value k of a flat output of
+    # len(entries) values, at (row, column) = divmod(entries[k][0], cols) of the matrix
+    sparse: bool = False
+
+    @property
+    def size(self) -> int:
+        """How many numbers the output holds: its nonzeros if sparse, else rows x cols."""
+        return len(self.entries) if self.sparse else self.rows * self.cols
+
+    def positions(self) -> dict:
+        """A sparse output's (row, column) of each value, in the values' order."""
+        return {"rows": [i // self.cols for i, _ in self.entries],
+                "cols": [i % self.cols for i, _ in self.entries]}
 
 
 @dataclass
@@ -194,7 +210,7 @@ def _printed(fn, temps, reduced, ops, ops_before, printer) -> EmittedFunction:
             if e != 0:
                 entries.append((idx, printer.doprint(e)))
         outs.append(Output(name, mat.rows, mat.cols, entries,
-                           vector=mat.cols == 1 and name not in fn.matrices))
+                           vector=mat.cols == 1 and name not in fn.matrices, sparse=name in fn.sparse))
         k += mat.rows * mat.cols
     return EmittedFunction(
         name=fn.name, doc=fn.doc,
@@ -345,6 +361,9 @@ def check_names(functions: list[Function]) -> None:
         for o in outs:
             if not IDENT.match(o) or len(set(outs)) != len(outs):
                 raise Unsupported(f"{fn.name}: output {o!r} cannot be emitted (an identifier, once)")
+        for o in fn.sparse:
+            if o not in outs:
+                raise Unsupported(f"{fn.name}: {o!r} is declared sparse but is none of its outputs")
 
 
 def _operator_dim(functions: list[Function]) -> int:
@@ -412,11 +431,13 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
     meta = dict(metadata)
     meta["generated"] = {"by": "derive", "source": source, "input_hash": digest,
                          "versions": tool_versions()}
-    # inputs and outputs as lists, in call order: every backend reads the order from here
+    # inputs and outputs as lists, in call order: every backend reads the order from here;
+    # a sparse output keeps its matrix's shape and gives the positions of its values
     meta["functions"] = {
         f.name: {"doc": f.doc,
                  "inputs": [{"name": i.name, "symbols": i.symbols} for i in f.inputs],
-                 "outputs": [{"name": o.name, "shape": [o.rows, o.cols], "vector": o.vector}
+                 "outputs": [dict({"name": o.name, "shape": [o.rows, o.cols], "vector": o.vector},
+                                  **({"nonzeros": o.positions()} if o.sparse else {}))
                              for o in f.outputs],
                  "ops": f.ops, "ops_before_cse": f.ops_before}
         for f in emitted["numpy"]}

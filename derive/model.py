@@ -110,6 +110,9 @@ class Function:
     # outputs that are matrices even when 1x1 (an operator of one coordinate); any other
     # one-column output is a vector
     matrices: tuple = ()
+    # outputs emitted as their structural nonzeros only: the values in a fixed order
+    # (row-major over the matrix), their (row, column) positions in metadata.json
+    sparse: tuple = ()
 
 
 @dataclass

@@ -157,16 +157,20 @@ def _build(cc: str, src: Path, out: Path, key: str) -> None:
 
 class BatchFunction:
     """A generated function over a batch: f(*inputs) with inputs of shape (n, len_i)
-    (broadcast from one set), returning outputs of shape (n,) + output shape."""
+    (broadcast from one set), returning outputs of shape (n,) + output shape, or (n, nonzeros)
+    for an output emitted as its structural nonzeros."""
 
     def __init__(self, model_name: str, fname: str):
         meta = load(model_name).meta["functions"][fname]
         self.name = fname
         # the C signature's order: metadata lists inputs and outputs in call order
         self.in_lens = [len(i["symbols"]) for i in meta["inputs"]]
-        self.out_shapes = [tuple(o["shape"]) for o in meta["outputs"]]
+        # an output emitted as its structural nonzeros is a flat vector of them (the NumPy
+        # backend's shape too), its positions in metadata.json
+        self.out_shapes = [(len(o["nonzeros"]["rows"]), 1) if "nonzeros" in o else tuple(o["shape"])
+                           for o in meta["outputs"]]
         # the NumPy backend's shapes: a column is a vector unless the model says matrix
-        self.out_vector = [o.get("vector", o["shape"][1] == 1) for o in meta["outputs"]]
+        self.out_vector = ["nonzeros" in o or o.get("vector", o["shape"][1] == 1) for o in meta["outputs"]]
         self._fn = _entry(model_name, f"{model_name}_{fname}_batch")
 
     def __call__(self, *inputs):
@@ -321,3 +325,73 @@ class ModeFormulasSelected:
 def mode_formulas_selected(model_name: str) -> ModeFormulasSelected:
     """The compiled selection of a model's mode formulas (CompilerUnavailable when it has none)."""
     return _built(ModeFormulasSelected, model_name)
+
+
+class SensitivityNullVectors:
+    """The generated null vectors of the roots (templates/sensitivity.c.j2;
+    gyro.analyses.sensitivity._null_vectors with one LU per root, in C)."""
+
+    def __init__(self, model_name: str):
+        self._fn = _entry(model_name, f"{model_name}_sens_null_vectors_batch")
+        self.n = _operator_dim(model_name)
+
+    def __call__(self, M, D, K, lam, hermitian, rhs):
+        """M, D, K (sets, n, n); lam (sets, r) complex roots; hermitian (sets,); rhs (n,)
+        complex. Returns (x, y, singular): x, y (sets, r, n) complex, singular (sets, r)."""
+        M, D, K = (np.ascontiguousarray(X, dtype=float) for X in (M, D, K))
+        N, n = M.shape[0], self.n
+        lam = np.ascontiguousarray(lam, dtype=complex)
+        _check(all(X.shape == (N, n, n) for X in (M, D, K)) and lam.ndim == 2 and lam.shape[0] == N,
+               f"M, D, K must be (sets, {n}, {n}) and lam (sets, roots)")
+        herm = np.ascontiguousarray(np.broadcast_to(hermitian, (N,)), dtype=float)
+        rhs = np.ascontiguousarray(rhs, dtype=complex)
+        _check(rhs.shape == (n,), f"rhs must be ({n},)")
+        x, y = np.empty(lam.shape + (n,), complex), np.empty(lam.shape + (n,), complex)
+        sing = np.empty(lam.shape)
+        ptr = ctypes.POINTER(ctypes.c_double)
+        self._fn(ctypes.c_long(N), ctypes.c_long(lam.shape[1]),
+                 *[a.ctypes.data_as(ptr) for a in (M, D, K, lam, herm, rhs, x, y, sing)])
+        return x, y, sing.astype(bool)
+
+
+def sens_null_vectors(model_name: str) -> SensitivityNullVectors:
+    """The compiled null vectors of a model (CompilerUnavailable when its C has none)."""
+    return _built(SensitivityNullVectors, model_name)
+
+
+class SensitivityContract:
+    """The generated contraction of the roots' sensitivities over the structural nonzeros
+    of the operator's Jacobian (templates/sensitivity.c.j2)."""
+
+    def __init__(self, model_name: str):
+        self._fn = _entry(model_name, f"{model_name}_sens_contract_batch")
+        self.n = _operator_dim(model_name)
+
+    def __call__(self, rows, cols, ncols, vals, M, D, lam, x, y):
+        """rows, cols (nnz,): positions in the layout (3 n^2, ncols); vals (sets, nnz); M, D
+        (sets, n, n); lam (sets, r) complex; x, y (sets, r, n) complex. Returns (h, den): h
+        (sets, r, ncols) complex, den (sets, r) complex."""
+        M, D = (np.ascontiguousarray(X, dtype=float) for X in (M, D))
+        N, n = M.shape[0], self.n
+        lam = np.ascontiguousarray(lam, dtype=complex)
+        x, y = (np.ascontiguousarray(v, dtype=complex) for v in (x, y))
+        vals = np.ascontiguousarray(vals, dtype=float)
+        rows = np.ascontiguousarray(rows, dtype=np.dtype(ctypes.c_long))
+        cols = np.ascontiguousarray(cols, dtype=np.dtype(ctypes.c_long))
+        nnz = rows.shape[0]
+        _check(all(X.shape == (N, n, n) for X in (M, D)) and lam.ndim == 2 and lam.shape[0] == N
+               and x.shape == y.shape == lam.shape + (n,), f"M, D (sets, {n}, {n}), lam (sets, r), x, y (sets, r, {n})")
+        _check(ncols >= 1 and rows.shape == cols.shape == (nnz,) and vals.shape == (N, nnz)
+               and bool(np.all((rows >= 0) & (rows < 3 * n * n))) and bool(np.all((cols >= 0) & (cols < ncols))),
+               f"rows in 0..{3 * n * n - 1}, cols in 0..{ncols - 1}, vals (sets, nnz)")
+        h, den = np.empty(lam.shape + (ncols,), complex), np.empty(lam.shape, complex)
+        ptr, lptr = ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_long)
+        self._fn(ctypes.c_long(N), ctypes.c_long(lam.shape[1]), ctypes.c_long(nnz), ctypes.c_long(ncols),
+                 rows.ctypes.data_as(lptr), cols.ctypes.data_as(lptr),
+                 *[a.ctypes.data_as(ptr) for a in (vals, M, D, lam, x, y, h, den)])
+        return h, den
+
+
+def sens_contract(model_name: str) -> SensitivityContract:
+    """The compiled contraction of a model's sensitivities (CompilerUnavailable when its C has none)."""
+    return _built(SensitivityContract, model_name)

@@ -93,15 +93,45 @@ def _reference(fn, vals):
     return out
 
 
+@functools.lru_cache(maxsize=None)
+def _nonzeros(model, fname):
+    """Per output of a function, the (rows, cols) of the values of one emitted as its
+    structural nonzeros (metadata.json), else None."""
+    outs = json.loads((GENERATED / model / "metadata.json").read_text())["functions"][fname]["outputs"]
+    return tuple((np.array(o["nonzeros"]["rows"]), np.array(o["nonzeros"]["cols"])) if "nonzeros" in o else None
+                 for o in outs)
+
+
+def _sizes(fn, model):
+    """How many numbers each output of fn is emitted as: its nonzeros if sparse."""
+    return [mat.rows * mat.cols if nz is None else len(nz[0])
+            for (_, mat), nz in zip(fn.outputs, _nonzeros(model, fn.name))]
+
+
+def _dense(fn, outs, model):
+    """The outputs as their matrices: a sparse one's values put at their positions in a
+    matrix of zeros, so that the comparison with the dense symbolic result also checks that
+    every entry left out is zero there."""
+    res = []
+    for o, (_, mat), nz in zip(outs, fn.outputs, _nonzeros(model, fn.name)):
+        o = np.asarray(o, dtype=float)
+        if nz is None:
+            res.append(o.reshape(mat.rows, mat.cols))
+            continue
+        a = np.zeros((mat.rows, mat.cols))
+        a[nz] = o.reshape(-1)
+        res.append(a)
+    return res
+
+
 def _call_c(lib, fn, vals, model=MODEL):
     args, outs = [], []
     for _, syms in fn.inputs:
         args.append((ctypes.c_double * len(syms))(*[vals[s] for s in syms]))
-    for _, mat in fn.outputs:
-        buf = (ctypes.c_double * (mat.rows * mat.cols))()
-        outs.append(buf)
+    for size in _sizes(fn, model):
+        outs.append((ctypes.c_double * size)())
     getattr(lib, f"{model}_{fn.name}")(*args, *outs)
-    return [np.array(list(b)).reshape(mat.rows, mat.cols) for b, (_, mat) in zip(outs, fn.outputs)]
+    return _dense(fn, [list(b) for b in outs], model)
 
 
 def _call_numpy(fn, vals, model=MODEL):
@@ -111,7 +141,7 @@ def _call_numpy(fn, vals, model=MODEL):
 
     args = [np.array([vals[s] for s in syms]) for _, syms in fn.inputs]
     res = getattr(nf, fn.name)(*args)
-    return list(res) if isinstance(res, tuple) else [res]
+    return _dense(fn, list(res) if isinstance(res, tuple) else [res], model)
 
 
 def _call_casadi(fn, vals, model=MODEL):
@@ -122,7 +152,7 @@ def _call_casadi(fn, vals, model=MODEL):
     args = [np.array([vals[s] for s in syms]) for _, syms in fn.inputs]
     res = getattr(cf, fn.name)(*args)
     res = list(res) if isinstance(res, (tuple, list)) else [res]
-    return [np.array(r.full()) for r in res]
+    return _dense(fn, [np.array(r.full()) for r in res], model)
 
 
 def _call_mpmath(fn, vals, model=MODEL):
@@ -139,16 +169,16 @@ def _call_mpmath(fn, vals, model=MODEL):
     # outside a function's real domain (acos of more than 1: no equilibrium) mpmath goes
     # complex where the double-precision backends give NaN
     real = lambda x: float(x) if not isinstance(x, mpmath.mpc) or x.imag == 0 else float("nan")  # noqa: E731
-    return [np.array([[real(x) for x in row] for row in r.tolist()], dtype=float) for r in res]
+    return _dense(fn, [np.array([[real(x) for x in row] for row in r.tolist()], dtype=float) for r in res], model)
 
 
 def _call_c_batch(lib, fn, points, model=MODEL):
     """The `_batch` entry point over several points at once, packed set after set."""
     ptr = ctypes.POINTER(ctypes.c_double)
     ins = [np.array([[v[s] for s in syms] for v in points]) for _, syms in fn.inputs]
-    outs = [np.zeros((len(points), mat.rows * mat.cols)) for _, mat in fn.outputs]
+    outs = [np.zeros((len(points), size)) for size in _sizes(fn, model)]
     getattr(lib, f"{model}_{fn.name}_batch")(ctypes.c_long(len(points)), *[a.ctypes.data_as(ptr) for a in ins + outs])
-    return [[o[k].reshape(mat.rows, mat.cols) for o, (_, mat) in zip(outs, fn.outputs)] for k in range(len(points))]
+    return [_dense(fn, [o[k] for o in outs], model) for k in range(len(points))]
 
 
 def _compare(got, ref, what):
@@ -199,10 +229,17 @@ def test_the_documented_functions_are_the_derived_ones(name):
 def test_generated_code_matches_symbolic(name, fname, compiled):
     """C (compiled with -Wall -Wextra -Werror), NumPy, CasADi and mpmath at 100 random
     points of every emitted function of every model, each entry to 1e-12 of its term scale;
-    the C batch entry point over the same points gives the same bytes as the single calls."""
+    the C batch entry point over the same points gives the same bytes as the single calls.
+    An output emitted as its structural nonzeros is compared as its matrix (its values at
+    their positions, zeros elsewhere): the values and that nothing nonzero was left out."""
     model, _, functions = derived(name)
     lib = compiled(name)
     fn = functions[fname]
+    for (oname, mat), nz in zip(fn.outputs, _nonzeros(name, fname)):
+        if nz is not None:  # each position once, within the matrix, row-major
+            flat = nz[0] * mat.cols + nz[1]
+            assert np.all(np.diff(flat) > 0) and np.all((nz[1] >= 0) & (nz[1] < mat.cols)) \
+                and np.all((nz[0] >= 0) & (nz[0] < mat.rows)), (fname, oname)
     rng = random.Random(f"2024:{name}:{fname}")  # each function's own points, whatever runs first
     shapes = [(mat.rows, mat.cols) for _, mat in fn.outputs]
     points, singles = [], []

@@ -465,3 +465,29 @@ def test_a_steady_motion_that_these_parameters_do_not_allow_has_no_equilibrium(t
     P = np.array([[1.0, 4.0, 0.1, 2.0, 0.2], [1.0, 4.0, 0.1, 2.0, 0.3]])
     qe, ok = equilibria(model, P)
     assert ok.tolist() == [True, False] and qe[0, 0] == 0.0 and np.isnan(qe[1, 0])
+
+
+def test_an_output_declared_sparse_is_its_nonzeros_with_their_positions():
+    """An output a Function declares sparse is emitted as its structural nonzeros, row-major,
+    with their (row, column) positions; the other outputs stay matrices. A sparse name that
+    is none of the outputs is refused. Through the NumPy template: the values in that order."""
+    from derive.emit import NumpyPrinter, _cse, _printed, check_names, environment
+    from derive.model import Function, Unsupported
+
+    a, b = sp.symbols("a b")
+    fn = Function("thing", [("params", [a, b])], [("X", sp.Matrix([[a, 0, 2], [0, 0, a * b]])),
+                                                  ("y", sp.Matrix([a, b]))], "doc", sparse=("X",))
+    check_names([fn])
+    with pytest.raises(Unsupported, match="declared sparse"):
+        check_names([Function("thing", fn.inputs, fn.outputs, "doc", sparse=("Z",))])
+    out = _printed(fn, *_cse(fn), NumpyPrinter())
+    X, y = out.outputs
+    assert X.sparse and X.size == 3 and X.positions() == {"rows": [0, 0, 1], "cols": [0, 2, 2]}
+    assert not y.sparse and y.size == 2
+    text = environment().get_template("numpy_functions.py.j2").render(
+        template="numpy_functions.py.j2", functions=[out], model="m", title="t", paper="p", source="s",
+        digest="0", versions={}, prefix="m", qep_n=0, select=None)
+    ns: dict = {}
+    exec(compile(text, "numpy_functions.py", "exec"), ns)
+    Xv, yv = ns["thing"](np.array([[3.0, 5.0], [1.0, 2.0]]))
+    assert Xv.tolist() == [[3.0, 2.0, 15.0], [1.0, 2.0, 2.0]] and yv.tolist() == [[3.0, 5.0], [1.0, 2.0]]

@@ -122,7 +122,8 @@ def call(E: Emitted, fname: str, vals: dict, backend: str) -> list[np.ndarray]:
     shapes = [tuple(o["shape"]) for o in fmeta["outputs"]]
     if backend == "c":
         args = [(ctypes.c_double * len(g))(*g) for g in groups]
-        outs = [(ctypes.c_double * (r * c))() for r, c in shapes]
+        outs = [(ctypes.c_double * (len(o["nonzeros"]["rows"]) if "nonzeros" in o else r * c))()
+                for (r, c), o in zip(shapes, fmeta["outputs"])]
         fn = getattr(E.lib, f"{E.name}_{fname}")
         fn.restype = None
         fn(*args, *outs)
@@ -140,7 +141,15 @@ def call(E: Emitted, fname: str, vals: dict, backend: str) -> list[np.ndarray]:
     else:
         raise ValueError(backend)
     assert len(res) == len(shapes), (backend, fname)
-    return [np.asarray(r, dtype=float).reshape(s) for r, s in zip(res, shapes)]
+    out = []
+    for r, s, o in zip(res, shapes, fmeta["outputs"]):
+        r = np.asarray(r, dtype=float)
+        if "nonzeros" in o:  # emitted as its structural nonzeros: its matrix, zeros elsewhere
+            a = np.zeros(s)
+            a[o["nonzeros"]["rows"], o["nonzeros"]["cols"]] = r.reshape(-1)
+            r = a
+        out.append(r.reshape(s))
+    return out
 
 
 def every_backend(E: Emitted, fname: str, vals: dict) -> dict[str, list[np.ndarray]]:

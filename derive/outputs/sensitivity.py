@@ -1,7 +1,10 @@
 """Parameter derivatives of the exact operator and of the equilibrium equations: the
 pieces of the eigenvalue derivative d lambda / d p_j = -(y* dJ/dp_j x) / (y* J'(lambda) x),
 with the equilibrium's own dependence dq_e/dp_j = -(dr/dq_e)^-1 dr/dp_j included by the
-runtime (gyro/analyses/sensitivity.py)."""
+runtime (gyro/analyses/sensitivity.py).
+
+dMDK is emitted as its structural nonzeros only (a few hundred of 3 n^2 (params + coordinates)
+entries): the runtime contracts over them, with their positions from metadata.json."""
 from __future__ import annotations
 
 import sympy as sp
@@ -30,5 +33,6 @@ def functions(d) -> list[Function]:
     return [Function("operator_sensitivity", d.state(),
                      [("dMDK", dJ), ("dr", dr)],
                      "Jacobians with respect to (" + names + "): dMDK of the entries of M, D and K "
-                     "(row-major, M then D then K; one row an entry) and dr of the equilibrium "
-                     "residual (one row an equation).", ("dMDK", "dr"))]
+                     "(row-major, M then D then K; one row an entry), as its structural nonzeros "
+                     "(their rows and columns in metadata.json), and dr of the equilibrium "
+                     "residual (one row an equation).", ("dMDK", "dr"), sparse=("dMDK",))]

@@ -11,10 +11,13 @@ dq_e/dp = -(dr/dq_e)^-1 dr/dp. A frequency omega = |Im lambda| then has
 d omega / d p_j = sign(Im lambda) Im(d lambda / d p_j).
 
 The partial derivatives of M, D, K and r come from the derivation (the emitted
-`operator_sensitivity`, compiled where there is a compiler), or, for a model emitted
-without it, from CasADi's algorithmic differentiation of the emitted `operator` and
+`operator_sensitivity`, compiled where there is a compiler; the Jacobian of M, D, K as its
+structural nonzeros, their positions in metadata.json), or, for a model emitted without it,
+from CasADi's algorithmic differentiation of the emitted `operator` and
 `equilibrium_residual` (`route='casadi'`). Both are exact (no step size); bench/scale.py
-measures which is faster.
+measures which is faster. The null vectors (one LU of J per root) and the contraction over
+the nonzeros are compiled with the model's C (templates/sensitivity.c.j2), with NumPy the
+fallback that gives the same numbers.
 
 A double or nearly double root has no derivative (it is not differentiable where two roots
 meet, and first order holds only for moves far below their distance): a root closer than
@@ -27,14 +30,14 @@ from functools import lru_cache
 
 import numpy as np
 
-from gyro import ladder
+from gyro import cbackend, ladder
 from gyro.equilibrium import operators
-from gyro.kernels import function
+from gyro.kernels import compiled, function
 from gyro.models import Model
 from gyro.results import Sensitivities, Spectrum
 
 DOUBLE = 1e-6  # relative distance between two roots below which they count as one double root
-CHUNK = 1024  # sets per call: the Jacobians take about 60 kB a set
+CHUNK = 1024  # sets per call: the Jacobians' nonzeros take about 7 kB a set, the vectors 3 kB
 
 
 def has_emitted(model: Model) -> bool:
@@ -63,24 +66,43 @@ def _casadi_function(model: Model):
     return ca.Function("operator_sensitivity_ad", [p, q], [j.nz[:] for j in jac]), where
 
 
-def partials(model: Model, P: np.ndarray, qe: np.ndarray, route: str = "auto"):
-    """dMDK (sets, 3 n^2, params + coordinates) and dr (sets, n, params + coordinates)."""
+@lru_cache(maxsize=None)
+def _emitted_positions(model: Model):
+    """(rows, cols) of the values of the emitted dMDK, its structural nonzeros (metadata.json)."""
+    o = next(o for o in model.meta["functions"]["operator_sensitivity"]["outputs"] if o["name"] == "dMDK")
+    return np.array(o["nonzeros"]["rows"]), np.array(o["nonzeros"]["cols"])
+
+
+def sparse_partials(model: Model, P: np.ndarray, qe: np.ndarray, route: str = "auto"):
+    """(values, rows, cols, dr): the structural nonzeros of dMDK, values (sets, nonzeros) at
+    (rows, cols) of the layout of `partials`, and dr (sets, n, params + coordinates) dense.
+    The emitted route's positions are the derivation's (metadata.json), CasADi's its own
+    sparsity of the same Jacobian."""
     if route == "auto":
         route = "emitted" if has_emitted(model) else "casadi"
     if route == "emitted":
         with np.errstate(all="ignore"):
-            dJ, dr = function(model, "operator_sensitivity")(P, qe)
-        return dJ, dr
+            vals, dr = function(model, "operator_sensitivity")(P, qe)
+        return (vals, *_emitted_positions(model), dr)
     if route != "casadi":
         raise ValueError(f"route: 'auto', 'emitted' or 'casadi', got {route!r}")
     N = P.shape[0]
     f, where = _casadi_function(model)
-    out = []
-    for nz, (rows, cols, shape) in zip(f.map(N)(P.T, qe.T), where):
-        a = np.zeros((N,) + shape)
-        a[:, rows, cols] = np.asarray(nz).T
-        out.append(a)
-    return out
+    nz_J, nz_r = f.map(N)(P.T, qe.T)
+    (rows, cols, _), (r_rows, r_cols, r_shape) = where
+    dr = np.zeros((N,) + r_shape)
+    dr[:, r_rows, r_cols] = np.asarray(nz_r).T
+    return np.asarray(nz_J).T, rows, cols, dr
+
+
+def partials(model: Model, P: np.ndarray, qe: np.ndarray, route: str = "auto"):
+    """dMDK (sets, 3 n^2, params + coordinates) and dr (sets, n, params + coordinates), dense."""
+    vals, rows, cols, dr = sparse_partials(model, P, qe, route)
+    n = next(o["shape"][0] for o in model.meta["functions"]["operator"]["outputs"] if o["name"] == "M")
+    shape = (3 * n * n, dr.shape[2])
+    dJ = np.zeros((P.shape[0],) + shape)
+    dJ[:, rows, cols] = vals
+    return dJ, dr
 
 
 def _solve_or_svd(A: np.ndarray, b: np.ndarray, halve: bool = True) -> np.ndarray:
@@ -108,7 +130,12 @@ def _solve_or_svd(A: np.ndarray, b: np.ndarray, halve: bool = True) -> np.ndarra
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
-def _null_vectors(M, D, K, lam, hermitian):
+def _start(n: int) -> np.ndarray:
+    """The fixed generic start b of the inverse iteration: unit, no component zero."""
+    return np.exp(1j * np.arange(1, n + 1)) / np.sqrt(n)
+
+
+def _null_vectors(M, D, K, lam, hermitian, kernel=None):
     """Right and left null vectors of J(lambda) for a batch (sets, modes): one step of
     inverse iteration from a fixed generic start, taken at lambda (1 + 1e-15); the left
     one is the right one where J is Hermitian (a conservative set at a root on the
@@ -117,9 +144,16 @@ def _null_vectors(M, D, K, lam, hermitian):
     DOUBLE); the move keeps J(lambda) from being singular to the last bit (a decoupled mode,
     omega_p^2 m = Kp exactly, has an exact zero pivot at lambda), and it is relative to the
     root's own scale: a shift of J by a fraction of its largest entry would not be (the
-    entries span eleven decades here, and omega1's derivative lost five digits to one)."""
+    entries span eleven decades here, and omega1's derivative lost five digits to one).
+
+    With `kernel` (gyro.cbackend.sens_null_vectors), one LU factorisation of J per root
+    gives both vectors (J x = b and J^H y = b); a J with an exactly zero pivot in that LU
+    goes to `_solve_or_svd`, as on the NumPy path. Without, NumPy's batched solve (a second
+    one for the left vectors of the non-Hermitian sets). A root's J is singular to its last
+    bits (the shift is below the rounding of its entries), so whether a pivot comes out
+    exactly zero depends on the order of the elimination's operations: the two paths meet
+    exact zeros at different roots."""
     N, m, n = M.shape[0], lam.shape[1], M.shape[-1]
-    b = np.broadcast_to(np.exp(1j * np.arange(1, n + 1)) / np.sqrt(n), (N * m, n))
 
     def J(rel):
         L = (lam * (1 + rel))[:, :, None, None]
@@ -128,6 +162,18 @@ def _null_vectors(M, D, K, lam, hermitian):
     def left(A):
         return np.conj(np.swapaxes(A, -1, -2))
 
+    b = np.broadcast_to(_start(n), (N * m, n))
+    if kernel is not None:
+        x, y, singular = kernel(M, D, K, lam, hermitian, _start(n))
+        s, t = np.nonzero(singular)
+        if s.size:  # an exactly zero pivot in C's LU: these few as the NumPy path takes them
+            L = (lam[s, t] * (1 + 1e-15))[:, None, None]
+            A = M[s] * L**2 + D[s] * L + K[s]
+            x[s, t] = y[s, t] = _solve_or_svd(A, b[:s.size])
+            h = np.flatnonzero(~hermitian[s])
+            if h.size:
+                y[s[h], t[h]] = _solve_or_svd(left(A[h]), b[:h.size])
+        return x, y
     A = J(1e-15)
     x = _solve_or_svd(A.reshape(N * m, n, n), b).reshape(N, m, n)
     y = x.copy()
@@ -135,6 +181,28 @@ def _null_vectors(M, D, K, lam, hermitian):
     if h.size:
         y[h] = _solve_or_svd(left(A[h]).reshape(h.size * m, n, n), b[:h.size * m]).reshape(h.size, m, n)
     return x, y
+
+
+def _contract(rows, cols, ncols, vals, M, D, lam, x, y, kernel=None):
+    """(h, den) for a batch (sets, modes): h[c] = y* (dJ/dw_c) x summed over the structural
+    nonzeros (rows, cols) of column c of the Jacobian of M, D, K (rows: which n^2 + row n +
+    col, M then D then K, so dJ = dM lambda^2 + dD lambda + dK), and den = y* J'(lambda) x,
+    J' = 2 M lambda + D. With `kernel` (gyro.cbackend.sens_contract) in C over the nonzeros
+    themselves; without, NumPy over the Jacobian's nonzero rows, dense in the columns."""
+    if kernel is not None:
+        return kernel(rows, cols, ncols, vals, M, D, lam, x, y)
+    n = M.shape[-1]
+    live, at = np.unique(rows, return_inverse=True)
+    V = np.zeros((vals.shape[0], live.size, ncols))
+    V[:, at, cols] = vals
+    which, entry = np.divmod(live, n * n)
+    row, col = np.divmod(entry, n)
+    T = lambda X: np.swapaxes(X, -1, -2)  # noqa: E731
+    yc = np.conj(y)
+    den = 2 * lam * np.sum(yc * (x @ T(M)), axis=-1) + np.sum(yc * (x @ T(D)), axis=-1)  # y* J'(lambda) x
+    weight = np.stack([lam**2, lam, np.ones_like(lam)], axis=-1)  # dM lambda^2 + dD lambda + dK
+    G = yc[:, :, row] * x[:, :, col] * weight[:, :, which]  # (sets, modes, live)
+    return G.real @ V + 1j * (G.imag @ V), den  # two real products
 
 
 def _equilibrium_derivative(drq, drp):
@@ -179,30 +247,26 @@ def _chunk(model: Model, P: np.ndarray, spec: Spectrum, route: str) -> np.ndarra
     if k.size == 0:
         return out
     P, qe = P[k], qe[k]
-    dJ, dr = partials(model, P, qe, route)
+    vals, rows, cols, dr = sparse_partials(model, P, qe, route)
+    if np.any(np.diff(rows) < 0):  # the C contraction takes each entry's nonzeros together
+        order = np.argsort(rows, kind="stable")
+        vals, rows, cols = vals[:, order], rows[order], cols[order]
     M, D, K = operators(model, P, qe)
     # dq_e/dp from r(p, q_e) = 0, on the rows of the equilibrium equations
     drq, drp = dr[:, idx, npar:], dr[:, idx, :npar]
-    # only the entries of M, D, K that some set has nonzero enter the contraction
-    live = np.flatnonzero(np.any(dJ != 0, axis=(0, 2)))
-    dJ = dJ[:, live]
     with np.errstate(all="ignore"):
         dq = _equilibrium_derivative(drq, drp) if nq else np.zeros((k.size, 0, npar))
-        total = dJ[:, :, :npar] + dJ[:, :, npar:] @ dq  # (sets, live entries, params)
-    which, entry = np.divmod(live, n * n)
-    row, col = np.divmod(entry, n)
     lam = spec.growth[k] + 1j * spec.frequencies[k]  # (sets, modes)
     # J(i omega) is Hermitian for M, K symmetric and D skew (to the last bit) at growth 0
     T = lambda X: np.swapaxes(X, -1, -2)  # noqa: E731
     hermitian = (np.all(M == T(M), axis=(1, 2)) & np.all(K == T(K), axis=(1, 2)) & np.all(D == -T(D), axis=(1, 2))
                  & np.all(spec.growth[k] == 0, axis=1))
-    x, y = _null_vectors(M, D, K, lam, hermitian)
-    yc = np.conj(y)
-    den = 2 * lam * np.sum(yc * (x @ T(M)), axis=-1) + np.sum(yc * (x @ T(D)), axis=-1)  # y* J'(lambda) x
-    weight = np.stack([lam**2, lam, np.ones_like(lam)], axis=-1)  # dM lambda^2 + dD lambda + dK
-    G = yc[:, :, row] * x[:, :, col] * weight[:, :, which]  # (sets, modes, live)
-    num = G.real @ total + 1j * (G.imag @ total)  # (sets, modes, params): two real products
+    x, y = _null_vectors(M, D, K, lam, hermitian, compiled(cbackend.sens_null_vectors, model))
     with np.errstate(all="ignore"):
+        h, den = _contract(rows, cols, npar + nq, vals, M, D, lam, x, y, compiled(cbackend.sens_contract, model))
+        # the total derivative: direct, and through the equilibrium, dJ/dq dq/dp
+        hq = h[:, :, npar:]
+        num = h[:, :, :npar] + (hq.real @ dq + 1j * (hq.imag @ dq))  # (sets, modes, params)
         d = -num / den[:, :, None]
     out[k] = np.sign(lam.imag)[:, :, None] * d.imag
     return out

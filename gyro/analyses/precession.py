@@ -165,6 +165,7 @@ def oscillating_base(values: dict, terms) -> OscillatingBase:
     return OscillatingBase(values, terms)
 
 
+@lru_cache(maxsize=16)
 def _base_signals(base):
     """(t, the rungs of the model's time-varying parameters as a CasADi SX column in the
     emitted order (metadata 'varying': each value, then its derivatives), a Function of t
@@ -191,6 +192,12 @@ def _base_signals(base):
             rungs.append(r)
     col = ca.densify(ca.vertcat(*rungs))
     return t, col, ca.Function("base_rate", [t], [col])
+
+
+def base_rungs(base, t) -> np.ndarray:
+    """The rungs of a base base(t) at the times t, (len(t), rungs) in the emitted order of the
+    `*_varying` functions' group `signals` (u_xi, u_xi', u_eta, u_eta', u_zeta, u_zeta')."""
+    return _signals_at(_base_signals(base)[2], t)
 
 
 def _signals_at(fun, t) -> np.ndarray:

@@ -137,13 +137,12 @@ def oscillation(component: str, amplitude, frequency, phase=0.0, what: str = "ba
     return Oscillation(component, amp, freq, ph)
 
 
+@dataclass(frozen=True)
 class OscillatingBase:
-    """u(t) = (u_xi, u_eta, u_zeta) of the parameters plus each Oscillation's
-    AMP sin(FREQ t + PHASE) on its component: a base(t) for `simulate`."""
-
-    def __init__(self, values: dict, terms):
-        self.constant = tuple(float(values[b]) for b in BASE)
-        self.terms = tuple(terms)
+    """u(t) = `constant` (u_xi, u_eta, u_zeta) plus each Oscillation's AMP sin(FREQ t + PHASE)
+    on its component: a base(t) for `simulate`; equal bases share their integrators."""
+    constant: tuple
+    terms: tuple
 
     def __call__(self, t):
         u = list(self.constant)
@@ -162,7 +161,9 @@ class OscillatingBase:
 
 
 def oscillating_base(values: dict, terms) -> OscillatingBase:
-    return OscillatingBase(values, terms)
+    """The base of the parameters' constant rate `values` (u_xi, u_eta, u_zeta) and the
+    Oscillations `terms` about it."""
+    return OscillatingBase(tuple(float(values[b]) for b in BASE), tuple(terms))
 
 
 @lru_cache(maxsize=16)
@@ -179,8 +180,9 @@ def _base_signals(base):
             u = base(t)
         u = [ca.SX(c) for c in u]
     except Exception as exc:  # noqa: BLE001 - any failure of the user's function says the same
+        why = (str(exc).strip().splitlines() or [""])[0]
         raise ParameterError(f"base: the base rate must be a function of t giving (u_xi, u_eta, u_zeta) as a "
-                             f"closed form of NumPy functions ({type(exc).__name__}: {exc})") from None
+                             f"closed form of NumPy functions ({type(exc).__name__}: {why})") from None
     if len(u) != len(BASE) or any(c.numel() != 1 for c in u):
         raise ParameterError(f"base: the base rate must give three numbers (u_xi, u_eta, u_zeta), got {len(u)}")
     rungs = []

@@ -241,3 +241,21 @@ def test_simulate_bad_base_rate_exits_2_in_one_line_and_writes_nothing(tmp_path,
 def test_base_rate_only_for_the_precession_model():
     rc, _, err = run_cli("simulate", "gimbal_gyroscope", "--t-end", "1", "--base-rate", "eta=1e-3:1")
     assert rc == 2 and "--base-rate: only for gimbal_precession" in err
+
+
+def test_a_motion_to_beta_90_deg_on_a_turning_base_is_refused_where_it_gets_there():
+    """l_x = 0.1 N m on a pitching base, u_eta(t) = u_eta + A sin(w t): at alpha = 0 the first
+    of (13) is (u_eta(t) + beta') H = l_x, so beta = (l_x/H - u_eta) t - A (1 - cos(w t))/w
+    reaches 90 deg at the root below (19.891 s); the diagnosis integrates again in pieces, each
+    starting at the time it has reached (the base is not autonomous), and finds it there."""
+    from scipy.optimize import brentq
+
+    A, w = 0.05, 0.2
+    rc, out, err = run_cli("simulate", "gimbal_precession", "--level", "rigorous", "--t-end", "40", "--points", "11",
+                           "--set", "l_x=0.1", "--base-rate", f"eta={A}:{w}")
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "near +-90 deg" in err
+    t_stop = float(err.split("near t = ")[1].split(" s")[0])
+    ue = pr.parameters()["u_eta"]
+    root = brentq(lambda s: (0.1 - ue) * s - A * (1 - np.cos(w * s)) / w - np.pi / 2, 1, 40)
+    assert abs(t_stop - root) < 0.01

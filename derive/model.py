@@ -77,6 +77,13 @@ class Signal:
     description: str
     input: bool = True
     order: int = 2
+    # the name of a parameter that this signal makes time-varying (a base rate u_xi(t) of a
+    # constant u_xi), with input=False: the model is written in the parameter, derived and
+    # emitted at its constant value as if no such signal were declared, and the full
+    # equations and each quantity that contains the parameter are emitted once more,
+    # NAME_varying, with the parameter the signal's value and its derivatives entering
+    # through d/dt (docs/models.md)
+    parameter: str | None = None
 
     @property
     def symbols(self) -> list:

@@ -8,6 +8,7 @@ functions to emit, contributed by the output kinds of `derive/outputs/`.
 """
 from __future__ import annotations
 
+import dataclasses
 import random
 import sys
 import time
@@ -79,6 +80,11 @@ class Derivation:
     functions: list[Function] = field(default_factory=list)
     timings: list = field(default_factory=list)
     constraints: dict = field(default_factory=dict)  # holonomic: eliminated, or multipliers
+    # the parameters made signals (Signal.parameter): {"signals": every signal of the model in
+    # its order, "varying": those that make a parameter time-varying, "mass_matrix",
+    # "forcing": the full equations with those parameters the signals' values, "sub":
+    # parameter symbol -> the signal's value}; empty for a model without them
+    varying: dict = field(default_factory=dict)
 
     @property
     def momenta(self) -> list:
@@ -248,9 +254,49 @@ def _refuse_time_forcing(model: Model, order, residual, even) -> None:
                           f"say) leaves no equilibrium to linearise about; {UNBALANCE_HINT}")
 
 
+def _split_varying(model: Model) -> tuple[Model, list, list]:
+    """(the model without the signals that make a parameter time-varying, those signals, all
+    the model's signals): everything is derived at the parameters' constant values from the
+    first; `_varying_equations` derives the full equations again with the signals."""
+    varying = [s for s in model.signals if s.parameter is not None]
+    if not varying:
+        return model, [], list(model.signals)
+    names.check_model(model)  # the signals' names among every other emitted symbol
+    params = {p.name for p in model.parameters}
+    seen = set()
+    for sig in varying:
+        if sig.parameter not in params:
+            raise Unsupported(f"{model.name}: signal {sig.name!r} makes {sig.parameter!r} time-varying, "
+                              "which is not a parameter")
+        if sig.input:
+            raise Unsupported(f"{model.name}: signal {sig.name!r} makes the parameter {sig.parameter} "
+                              "time-varying: it stays in the equations (input=False), it is no input w")
+        if sig.parameter in seen:
+            raise Unsupported(f"{model.name}: the parameter {sig.parameter} is made time-varying twice")
+        seen.add(sig.parameter)
+    if model.holonomic:
+        raise Unsupported(f"{model.name}: a parameter made time-varying (signal {varying[0].name!r}) "
+                          "together with holonomic constraints")
+    return dataclasses.replace(model, signals=[s for s in model.signals if s.parameter is None]), varying, list(
+        model.signals)
+
+
+def _varying_equations(model: Model, L, Q, given, varying: list, signals: list) -> dict:
+    """The full equations in mass-matrix form with each parameter of `varying` replaced by
+    its signal's value: its derivatives enter through every d/dt (mechanics.chain), to the
+    signal's declared order (Unsupported beyond it)."""
+    sub = {model.param(sig.parameter).symbol: sig.symbol for sig in varying}
+    Lv = sp.sympify(L).xreplace(sub)
+    Qv = None if Q is None else [sp.sympify(x).xreplace(sub) for x in Q]
+    Mq, f = mech.mass_matrix_form(Lv, model.q, model.qd, Qv, signals)
+    f = sp.Matrix(mech.substitute(list(f), given))
+    return {"signals": signals, "varying": varying, "mass_matrix": Mq, "forcing": f, "sub": sub}
+
+
 def derive(model: Model, steps: Steps | None = None) -> Derivation:
     steps = steps or Steps()
     model = convert.convert(model)  # dynamicsymbols, assumptions, vectors: the machinery's symbols
+    model, varying, all_signals = _split_varying(model)
     eliminated = {}
     if model.holonomic:
         with steps("holonomic constraints: dependent coordinates solved for, or multipliers"):
@@ -291,6 +337,12 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
     with steps("equations of all coordinates, mass-matrix form"):
         Mq, f = mech.mass_matrix_form(L, q, qd, Q, signals)
         f = sp.Matrix(mech.substitute(list(f), given))
+
+    moving = {}
+    if varying:
+        with steps(f"equations of all coordinates with {', '.join(s.parameter for s in varying)} "
+                   "time-varying (signals)"):
+            moving = _varying_equations(model, L, Q, given, varying, all_signals)
 
     R = L0
     with steps(f"Routh reduction of the cyclic coordinates {', '.join(model.cyclic)}" if model.cyclic
@@ -389,6 +441,10 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
             deriv.variants[vname] = VariantResult(opv, blk, polys, scaled)
 
     deriv.timings = steps.timings
+    if moving and kinks.kinks:  # a kink's argument with the parameter time-varying too
+        for key in ("mass_matrix", "forcing"):
+            moving[key] = kinks.thaw(moving[key]).xreplace(moving["sub"])
+    deriv.varying = moving
     if kinks.kinks:  # each kink its function again; NaN where a derivative does not exist
         _thawed(deriv, kinks, reference, undefined)
     deriv.model = source

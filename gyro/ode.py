@@ -33,31 +33,39 @@ def _key(model: Model, what: str):
     return (what, model.name, str(getattr(model, "directory", "")), id(model))
 
 
-def symbolic(model: Model) -> Symbolic:
-    """The explicit ODE of a model as CasADi expressions (cached per model)."""
-    key = _key(model, "symbolic")
+def symbolic(model: Model, varying: bool = False) -> Symbolic:
+    """The explicit ODE of a model as CasADi expressions (cached per model). `varying`: the
+    equations with the model's time-varying parameters (metadata 'varying', the emitted
+    `mass_matrix_varying`, `forcing_varying`), whose inputs then include the group
+    `signals`: each such parameter's value and derivatives at t."""
+    key = _key(model, "symbolic_varying" if varying else "symbolic")
     if key not in _CACHE:
         import casadi as ca
 
         cf = model.casadi
         meta = model.meta["functions"]
+        suffix = "_varying" if varying else ""
         n = len(model.meta["coordinates"])
         y = ca.SX.sym("y", 2 * n)
         p = ca.SX.sym("p", len(model.param_names))
-        extra = tuple(ca.SX.sym(spec["name"], len(spec["symbols"])) for spec in meta["forcing"]["inputs"][3:])
-        f = cf.forcing(p, y[:n], y[n:], *extra)
-        ydot = ca.vertcat(y[n:], ca.solve(cf.mass_matrix(p, y[:n]), f))
+        specs = meta["forcing" + suffix]["inputs"][3:]
+        extra = tuple(ca.SX.sym(spec["name"], len(spec["symbols"])) for spec in specs)
+        f = getattr(cf, "forcing" + suffix)(p, y[:n], y[n:], *extra)
+        # the mass matrix's own inputs after (params, q): those of the forcing by name
+        by_name = {spec["name"]: x for spec, x in zip(specs, extra)}
+        mm = [by_name[spec["name"]] for spec in meta["mass_matrix" + suffix]["inputs"][2:]]
+        ydot = ca.vertcat(y[n:], ca.solve(getattr(cf, "mass_matrix" + suffix)(p, y[:n], *mm), f))
         _CACHE[key] = Symbolic(y, p, extra, ydot)
     return _CACHE[key]
 
 
-def rhs(model: Model):
+def rhs(model: Model, varying: bool = False):
     """The compiled CasADi Function rhs(y, p, *inputs) -> y' of a model (cached per model)."""
-    key = _key(model, "rhs")
+    key = _key(model, "rhs_varying" if varying else "rhs")
     if key not in _CACHE:
         import casadi as ca
 
-        s = symbolic(model)
+        s = symbolic(model, varying)
         _CACHE[key] = ca.Function("rhs", [s.y, s.p, *s.inputs], [s.ydot])
     return _CACHE[key]
 

@@ -491,3 +491,54 @@ def test_an_output_declared_sparse_is_its_nonzeros_with_their_positions():
     exec(compile(text, "numpy_functions.py", "exec"), ns)
     Xv, yv = ns["thing"](np.array([[3.0, 5.0], [1.0, 2.0]]))
     assert Xv.tolist() == [[3.0, 2.0, 15.0], [1.0, 2.0, 2.0]] and yv.tolist() == [[3.0, 5.0], [1.0, 2.0]]
+
+
+# --------------------------------------------------------------------- parameters made time-varying
+
+
+def _conveyor(**kw) -> Model:
+    """A mass on a spring whose anchor moves at the speed v (a parameter): L = m (x' + v)^2/2
+    - k x^2/2, so m (x'' + v') + k x = 0; with v(t) a signal the force -m v' appears."""
+    m, k, v = sp.symbols("m k v")
+    x, xd = sp.symbols("x x_d")
+    V = Signal("v_t", "m/s", "the anchor's speed at t", input=False, order=1, parameter="v")
+    params = [Parameter("m", "kg", 1.0, "mass"), Parameter("k", "N/m", 4.0, "stiffness"),
+              Parameter("v", "m/s", 0.5, "anchor speed", kind="real")]
+    base = dict(parameters=params, lagrangian=m * (xd + v)**2 / 2 - k * x**2 / 2, dissipation=0,
+                signals=[V], quantities={"momentum": (["params", "qd"], [("p", sp.Matrix([m * (xd + v)]))], "p"),
+                                         "spring": (["params", "q"], [("F", sp.Matrix([-k * x]))], "F")})
+    base.update(kw)
+    return _oscillator(**base)
+
+
+def test_a_parameter_made_time_varying_is_emitted_again_and_the_rest_is_unchanged():
+    m, k, v = sp.symbols("m k v")
+    x, xd = sp.symbols("x x_d")
+    v_t, v_t_d = sp.symbols("v_t v_t_d")
+    d = _derive(_conveyor())
+    plain = _derive(_conveyor(signals=[]))
+    fns, ref = {f.name: f for f in pipeline.functions(d)}, {f.name: f for f in pipeline.functions(plain)}
+    # every function of the constant parameter as it is without the signal
+    for name, f in ref.items():
+        assert fns[name].inputs == f.inputs and fns[name].outputs == f.outputs, name
+    assert set(fns) - set(ref) == {"mass_matrix_varying", "forcing_varying", "momentum_varying"}
+    fv = fns["forcing_varying"]
+    assert [g for g, _ in fv.inputs] == ["params", "q", "qd", "signals"] and fv.inputs[-1][1] == [v_t, v_t_d]
+    assert sp.expand(fv.outputs[0][1][0] - (-k * x - m * v_t_d)) == 0  # the anchor's acceleration, by d/dt
+    assert sp.expand(fns["forcing"].outputs[0][1][0] - (-k * x)) == 0
+    assert fns["momentum_varying"].outputs[0][1] == sp.Matrix([m * (xd + v_t)])
+    meta = pipeline.metadata(d)
+    assert meta["varying"] == [{"name": "v_t", "parameter": "v", "unit": "m/s", "description": "the anchor's speed at t",
+                                "order": 1, "symbols": ["v_t", "v_t_d"]}]
+    assert "signals" not in meta and "varying" not in pipeline.metadata(plain)
+
+
+@pytest.mark.parametrize("signal,needle", [
+    (Signal("v_t", "m/s", "speed", input=False, order=1, parameter="w"), "makes 'w' time-varying, which is not a parameter"),
+    (Signal("v_t", "m/s", "speed", input=True, order=1, parameter="v"), "it is no input w"),
+    (Signal("v_t", "m/s", "speed", input=False, order=0, parameter="v"), "v_t"),
+    (Signal("k", "m/s", "speed", input=False, order=1, parameter="v"), "'k' has the name of a parameter"),
+])
+def test_a_parameter_made_time_varying_wrongly_is_refused(signal, needle):
+    with pytest.raises(Unsupported, match=re.escape(needle)):
+        _derive(_conveyor(signals=[signal]))

@@ -7,7 +7,9 @@ Three bodies: the outer ring (axis xi = xi1 of the base), the inner ring or casi
 eta1 = y' of the outer ring), the rotor (axis z' of the casing). Angles alpha (outer ring
 against the base, about xi), beta (casing against the outer ring, about eta1), phi (rotor
 against the casing, about z'). The base turns at the absolute rate u, components
-u_xi, u_eta, u_zeta in its own axes (constants). Frames: base xi eta zeta, outer ring
+u_xi, u_eta, u_zeta in its own axes: constants, or given functions of time (`BASE_RATE`:
+each a signal that makes its parameter time-varying; the full level's equations then carry
+u' through d/dt of the kinetic energy, the precession levels u itself). Frames: base xi eta zeta, outer ring
 Rx(alpha), casing Rx(alpha) Ry(beta); the kinematics (3)-(5) are the angular velocities of
 these frames (`mechanics.angular_velocity`), proved equal to the print in
 `kinematics_are_the_papers`.
@@ -44,7 +46,7 @@ import math
 import sympy as sp
 
 from derive import mechanics as mech
-from derive.model import Load, Parameter
+from derive.model import Load, Parameter, Signal
 
 NAME = "gimbal_precession"
 TITLE = "Gyroscope in a gimbal on a rotating base: precession theory of the image point"
@@ -101,6 +103,10 @@ x, y = sp.symbols("x y")  # the image point
 x_d, y_d, H_d = sp.symbols("x_d y_d H_t_d")
 
 u = sp.Matrix([u_xi, u_eta, u_zeta])
+# a time-varying base (a ship's rolling and yaw): u_xi(t), u_eta(t), u_zeta(t) and their
+# rates, inputs of every function emitted again as NAME_varying (derive.model.Signal.parameter)
+BASE_RATE = [Signal(f"{p}_t", "rad/s", f"the base rate {p} at time t", input=False, order=1, parameter=p)
+             for p in ("u_xi", "u_eta", "u_zeta")]
 RING = [("x", alpha)]
 CASING = [("x", alpha), ("y", beta)]
 TABLE = mech.rotation(CASING)  # (17): rows x y z (base), columns x' y' z' (casing)
@@ -387,4 +393,5 @@ def build():
         quantities=quantities(),
         levels=levels(),
         aliases=CLI_NAMES,
+        signals=BASE_RATE,
     )

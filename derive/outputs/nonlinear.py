@@ -21,7 +21,7 @@ def functions(d) -> list[Function]:
     if timed:
         extra.append("the explicit time derivative of dL/dqd moved to f")
     note = f" ({'; '.join(extra)})" if extra else ""
-    return [
+    fns = [
         Function("mass_matrix", [params, ("q", model.q)] + timed, [("Mq", d.mass_matrix)],
                  "Mass matrix of the full nonlinear equations: Mq qdd = f.", MATRICES),
         Function("forcing", [params, ("q", model.q), ("qd", model.qd)] + timed + given,
@@ -30,3 +30,26 @@ def functions(d) -> list[Function]:
                  "Mq qdd = f, with the given functions' values and derivatives as inputs"
                  + note + "."),
     ]
+    if d.varying:  # the same equations with parameters made time-varying (Signal.parameter)
+        moving = ([("time", [TIME])] if d.time_dependent else []) + [
+            ("signals", [s for sig in d.varying["signals"] for s in sig.symbols])]
+        which = ", ".join(f"{sig.parameter} = {sig.name}(t)" for sig in d.varying["varying"])
+        fns += [
+            Function("mass_matrix_varying", [params, ("q", model.q)] + moving, [("Mq", d.varying["mass_matrix"])],
+                     f"Mass matrix of the full nonlinear equations with {which}: Mq qdd = f.", MATRICES),
+            Function("forcing_varying", [params, ("q", model.q), ("qd", model.qd)] + moving + given,
+                     [("f", d.varying["forcing"])],
+                     f"Right-hand side f of the full nonlinear equations with {which}, the signals' "
+                     "derivatives entering through d/dt" + note + "."),
+        ]
+    return fns
+
+
+def metadata(d) -> dict:
+    """The parameters made time-varying: each signal's name, parameter, order and rungs (the
+    inputs of the functions NAME_varying)."""
+    if not d.varying:
+        return {}
+    return {"varying": [{"name": sig.name, "parameter": sig.parameter, "unit": sig.unit,
+                         "description": sig.description, "order": sig.order,
+                         "symbols": [str(s) for s in sig.symbols]} for sig in d.varying["varying"]]}

@@ -30,7 +30,23 @@ def functions(d) -> list[Function]:
         outs = [(o, sp.Matrix(m)) for o, m in outputs]
         # a one-column output is a vector; wider ones are matrices
         fns.append(Function(name, ins, outs, doc, tuple(o for o, m in outs if m.cols > 1)))
+        if d.varying and any(m.free_symbols & set(d.varying["sub"]) for _, m in outs):
+            fns.append(_varying(d, name, ins, outs, doc))
     return fns
+
+
+def _varying(d, name, ins, outs, doc) -> Function:
+    """A quantity that contains a parameter made time-varying (Signal.parameter), once more
+    with the parameter the signal's value: NAME_varying, the signals' rungs its input group
+    `signals` (every signal of the model, in its order)."""
+    if name + "_varying" in d.model.quantities:
+        raise Unsupported(f"quantity {name}_varying: the name of quantity {name} with its parameters time-varying")
+    sub = d.varying["sub"]
+    every = [s for sig in d.varying["signals"] for s in sig.symbols]
+    ins = [g for g in ins if g[0] != "signals"] + [("signals", every)]
+    which = ", ".join(f"{sig.parameter} = {sig.name}(t)" for sig in d.varying["varying"])
+    outs = [(o, m.xreplace(sub)) for o, m in outs]
+    return Function(name + "_varying", ins, outs, f"{doc} With {which}.", tuple(o for o, m in outs if m.cols > 1))
 
 
 def metadata(d) -> dict:

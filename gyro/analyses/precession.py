@@ -15,10 +15,19 @@ functions, one integrator per level built once with the parameters as its input.
 The image point and the angles are converted by the generated `image_point` and
 `angles_of_image`. (13) is singular at beta = +-90 deg, and the image point leaves the
 picture plane at alpha = +-90 deg: a motion that reaches either (|cos| < 1e-3) is refused.
+
+A time-varying base: `simulate(..., base=u)` with u(t) -> (u_xi, u_eta, u_zeta) in rad/s, a
+closed form in t of NumPy functions (`oscillating_base` builds the command line's
+u_NAME + AMP sin(FREQ t + PHASE)). It is evaluated on a CasADi symbol, so that CVODES
+integrates the emitted `*_varying` functions (the model's base rate made signals) with u(t)
+exactly and the full level's u'(t) is its exact derivative; the parameters u_xi, u_eta,
+u_zeta are then unused.
 """
 from __future__ import annotations
 
 import time
+import warnings
+from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
@@ -33,6 +42,9 @@ RTOL, ATOL = 1e-12, 1e-14
 MAX_STEPS = 2 * 10**6  # full, over the horizon: its nutation at H/J rad/s sets the step
 MAX_STEPS_PRECESSION = 10**4  # between two output times (CVODES counts per output interval); the precession
 # levels take a few hundred for an hour at rtol 1e-12, so more means the singularity at beta = +-90 deg
+
+
+BASE = ("u_xi", "u_eta", "u_zeta")  # the components of the base rate, in the order base(t) gives them
 
 
 class Singular(ParameterError):
@@ -98,14 +110,150 @@ def _integrator(level: str, n_out: int, rtol_scale: float = 1.0):
     return ca.integrator(f"F_{level}", "cvodes", {"x": y, "p": P, "ode": T * rhs}, 0.0, grid, opts)
 
 
-def rates(level: str, P, state2, H_now) -> np.ndarray:
+@dataclass(frozen=True)
+class Oscillation:
+    """One harmonic term of a time-varying base: u_NAME(t) gains AMP sin(FREQ t + PHASE)
+    (rad/s, rad/s, rad), NAME one of xi, eta, zeta (a ship's rolling or yaw)."""
+    component: str
+    amplitude: float
+    frequency: float
+    phase: float = 0.0
+
+    def describe(self) -> dict:
+        return {"amplitude": self.amplitude, "frequency": self.frequency, "phase": self.phase}
+
+
+def oscillation(component: str, amplitude, frequency, phase=0.0, what: str = "base rate") -> Oscillation:
+    """An Oscillation with every number checked: a known component, finite numbers, a
+    frequency >= 0; ParameterError naming `what` otherwise."""
+    names = [b.split("_", 1)[1] for b in BASE]
+    if component not in names:
+        raise ParameterError(f"{what}: unknown component {component!r}; known: {', '.join(names)}")
+    amp = finite_number(f"{what} amplitude", amplitude)
+    freq = finite_number(f"{what} frequency", frequency)
+    ph = finite_number(f"{what} phase", phase)
+    if freq < 0:
+        raise ParameterError(f"{what}: the frequency must be >= 0 rad/s, got {freq!r}")
+    return Oscillation(component, amp, freq, ph)
+
+
+@dataclass(frozen=True)
+class OscillatingBase:
+    """u(t) = `constant` (u_xi, u_eta, u_zeta) plus each Oscillation's AMP sin(FREQ t + PHASE)
+    on its component: a base(t) for `simulate`; equal bases share their integrators."""
+    constant: tuple
+    terms: tuple
+
+    def __call__(self, t):
+        u = list(self.constant)
+        for o in self.terms:
+            k = BASE.index("u_" + o.component)
+            u[k] = u[k] + o.amplitude * np.sin(o.frequency * t + o.phase)
+        return tuple(u)
+
+    def describe(self) -> dict:
+        """The JSON form: {u_NAME: [{amplitude, frequency, phase}, ...]} of each component
+        that oscillates, about the parameters' constants."""
+        out = {}
+        for o in self.terms:
+            out.setdefault("u_" + o.component, []).append(o.describe())
+        return out
+
+
+def oscillating_base(values: dict, terms) -> OscillatingBase:
+    """The base of the parameters' constant rate `values` (u_xi, u_eta, u_zeta) and the
+    Oscillations `terms` about it."""
+    return OscillatingBase(tuple(float(values[b]) for b in BASE), tuple(terms))
+
+
+@lru_cache(maxsize=16)
+def _base_signals(base):
+    """(t, the rungs of the model's time-varying parameters as a CasADi SX column in the
+    emitted order (metadata 'varying': each value, then its derivatives), a Function of t
+    giving them): base(t) evaluated on a symbol, its derivatives exact."""
+    import casadi as ca
+
+    t = ca.SX.sym("t")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FutureWarning)  # NumPy functions on a CasADi symbol
+            u = base(t)
+        u = [ca.SX(c) for c in u]
+    except Exception as exc:  # noqa: BLE001 - any failure of the user's function says the same
+        why = (str(exc).strip().splitlines() or [""])[0]
+        raise ParameterError(f"base: the base rate must be a function of t giving (u_xi, u_eta, u_zeta) as a "
+                             f"closed form of NumPy functions ({type(exc).__name__}: {why})") from None
+    if len(u) != len(BASE) or any(c.numel() != 1 for c in u):
+        raise ParameterError(f"base: the base rate must give three numbers (u_xi, u_eta, u_zeta), got {len(u)}")
+    rungs = []
+    for sig in load(MODEL).meta["varying"]:
+        r = u[BASE.index(sig["parameter"])]
+        rungs.append(r)
+        for _ in range(sig["order"]):
+            r = ca.jacobian(r, t)
+            rungs.append(r)
+    col = ca.densify(ca.vertcat(*rungs))
+    return t, col, ca.Function("base_rate", [t], [col])
+
+
+def base_rungs(base, t) -> np.ndarray:
+    """The rungs of a base base(t) at the times t, (len(t), rungs) in the emitted order of the
+    `*_varying` functions' group `signals` (u_xi, u_xi', u_eta, u_eta', u_zeta, u_zeta')."""
+    return _signals_at(_base_signals(base)[2], t)
+
+
+def _signals_at(fun, t) -> np.ndarray:
+    """The rungs at the times t: (len(t), rungs), or one row for a number t."""
+    t = np.atleast_1d(np.asarray(t, float))
+    out = np.array(fun(t[None, :])).T if t.size > 1 else np.array(fun(t[0])).reshape(1, -1)
+    if not np.all(np.isfinite(out)):
+        raise ParameterError("base: the base rate or its derivative is not finite on the horizon")
+    return out
+
+
+@lru_cache(maxsize=16)
+def _integrator_varying(level: str, n_out: int, rtol_scale: float, base):
+    """As `_integrator` with the base rate base(t) in the emitted `*_varying` functions: the
+    input p is (parameters, the horizon T, the start time t0), t = t0 + T s."""
+    import casadi as ca
+
+    cf = load(MODEL).casadi
+    npar = len(load(MODEL).param_names)
+    P = ca.SX.sym("P", npar + 2)
+    p, T, t0 = P[:npar], P[npar], P[npar + 1]
+    s = ca.SX.sym("s")
+    tb, col, _ = _base_signals(base)
+    sig = ca.substitute(col, tb, t0 + T * s)
+    if level == "full":
+        from gyro import ode
+
+        so = ode.symbolic(load(MODEL), varying=True)
+        y = so.y
+        rhs = ca.substitute(ca.substitute(so.ydot, so.p, p), so.inputs[0], sig)
+    else:
+        y = ca.SX.sym("y", 3)
+        A, b = getattr(cf, f"{level}_system_varying")(p, y[:2], y[2], sig)
+        rhs = ca.solve(A, b)
+    grid = list(np.linspace(0.0, 1.0, n_out))
+    steps = max(500, MAX_STEPS // max(1, n_out - 1)) if level == "full" else MAX_STEPS_PRECESSION
+    opts = {"abstol": ATOL * rtol_scale, "reltol": RTOL * rtol_scale, "max_num_steps": steps, "linear_multistep_method": "adams",
+            "nonlinear_solver_iteration": "functional", "disable_internal_warnings": True}
+    return ca.integrator(f"F_{level}_varying", "cvodes", {"x": y, "t": s, "p": P, "ode": T * rhs}, 0.0, grid, opts)
+
+
+def rates(level: str, P, state2, H_now, signals=None) -> np.ndarray:
     """The rates of a precession level at one state (angles or image point, and H) from its
-    emitted linear system A r = b."""
-    A, b = getattr(load(MODEL).numpy, f"{level}_system")(P, state2, [H_now])
+    emitted linear system A r = b; `signals` the base rate's rungs at that instant (the
+    `*_varying` system) or None (the constant base of the parameters)."""
+    nf = load(MODEL).numpy
+    if signals is None:
+        A, b = getattr(nf, f"{level}_system")(P, state2, [H_now])
+    else:
+        A, b = getattr(nf, f"{level}_system_varying")(P, state2, [H_now], signals)
     return np.linalg.solve(A, b)
 
 
-def initial_state(level: str, values: dict) -> np.ndarray:
+def initial_state(level: str, values: dict, base=None) -> np.ndarray:
     nf = load(MODEL).numpy
     P = vector(values)
     a0, b0, H0 = values["alpha0"], values["beta0"], values["H"]
@@ -113,8 +261,13 @@ def initial_state(level: str, values: dict) -> np.ndarray:
         if abs(np.cos(ang)) < SINGULAR_COS:
             raise Singular(f"parameter {name}: at +-90 deg, where (13) is singular or the image point leaves the plane")
     if level == "full":
-        ad, bd, _ = rates("rigorous", P, [a0, b0], H0)
-        (pd,) = nf.spin_from_momentum(P, [a0, b0], [ad, bd], [H0])
+        if base is None:
+            ad, bd, _ = rates("rigorous", P, [a0, b0], H0)
+            (pd,) = nf.spin_from_momentum(P, [a0, b0], [ad, bd], [H0])
+        else:  # on the precession of the base rate at t = 0
+            s0 = _signals_at(_base_signals(base)[2], 0.0)[0]
+            ad, bd, _ = rates("rigorous", P, [a0, b0], H0, s0)
+            (pd,) = nf.spin_from_momentum_varying(P, [a0, b0], [ad, bd], [H0], s0)
         return np.array([a0, b0, 0.0, ad, bd, pd])
     if level == "rigorous":
         return np.array([a0, b0, H0])
@@ -130,7 +283,7 @@ class IntegrationBudget(RuntimeError):
 NEAR_SINGULAR_COS = 0.05  # |cos| of beta or alpha at the last state reached: on the way to +-90 deg
 
 
-def _why_stopped(level: str, P, y0, T: float, rtol_scale: float = 1.0) -> Exception:
+def _why_stopped(level: str, P, y0, T: float, rtol_scale: float = 1.0, base=None) -> Exception:
     """Why CVODES stopped before T: the motion is integrated again over doubling horizons
     T 2^-40, T 2^-39, ..., T (one output each, restarting from the state reached: the
     levels are autonomous) until one fails, and on from there by halved steps (60 tries,
@@ -138,17 +291,26 @@ def _why_stopped(level: str, P, y0, T: float, rtol_scale: float = 1.0) -> Except
     deg (Singular, bad input for the level) or not (the step budget: IntegrationBudget).
     The full level, whose pieces would each cost its whole budget again, is said to have
     stopped by its budget or a failed step (its samples show the singularity where it
-    integrates)."""
+    integrates). With a time-varying base each piece starts at the time it has reached."""
     if level == "full":  # its pieces would cost the whole budget again (seconds): said as it is
         return IntegrationBudget(f"full: CVODES stopped before t = {T:.6g} s (its step budget of "
                                  f"{MAX_STEPS:.3g} steps over the horizon, or a failed step)")
     nf = load(MODEL).numpy
-    F = _integrator(level, 2, rtol_scale)
+    if base is None:
+        F = _integrator(level, 2, rtol_scale)
+
+        def inputs(dt, _t0):
+            return np.append(P, dt)
+    else:
+        F = _integrator_varying(level, 2, rtol_scale, base)
+
+        def inputs(dt, t0):
+            return np.append(P, [dt, t0])
     y, reached, step = np.asarray(y0, float), 0.0, 0.0
     for k in range(41):
         target = T * 2.0 ** (k - 40)
         try:
-            y = np.array(F(x0=y, p=np.append(P, target - reached))["xf"])[:, -1]
+            y = np.array(F(x0=y, p=inputs(target - reached, reached))["xf"])[:, -1]
         except RuntimeError:
             step = target - reached
             break
@@ -161,7 +323,7 @@ def _why_stopped(level: str, P, y0, T: float, rtol_scale: float = 1.0) -> Except
         if step <= 0:
             break
         try:
-            y = np.array(F(x0=y, p=np.append(P, step))["xf"])[:, -1]
+            y = np.array(F(x0=y, p=inputs(step, reached))["xf"])[:, -1]
             reached += step
             step *= 2
         except RuntimeError:
@@ -178,10 +340,12 @@ def _why_stopped(level: str, P, y0, T: float, rtol_scale: float = 1.0) -> Except
                              "not at +-90 deg; a shorter --t-end")
 
 
-def simulate(values: dict, t, level: str, rtol_scale: float = 1.0):
+def simulate(values: dict, t, level: str, rtol_scale: float = 1.0, base=None):
     """The motion of one level at the times t (t[0] = 0): ImagePointMotion. Singular when it
     reaches beta or alpha = +-90 deg; IntegrationBudget when the integrator stops by its
-    step budget elsewhere."""
+    step budget elsewhere. `base`: None (the constant base rate of the parameters) or a
+    function of t giving (u_xi, u_eta, u_zeta) in rad/s (see the module's doc); its
+    `describe()`, where it has one, is the result's `base_rate`."""
     from gyro.results import ImagePointMotion
 
     if level not in LEVELS:
@@ -189,21 +353,27 @@ def simulate(values: dict, t, level: str, rtol_scale: float = 1.0):
     t = np.asarray(t, float)
     nf = load(MODEL).numpy
     P = vector(values)
-    y0 = initial_state(level, values)
+    y0 = initial_state(level, values, base)
     T = float(t[-1])
-    F = _integrator(level, len(t), rtol_scale)
+    if base is None:
+        F, p = _integrator(level, len(t), rtol_scale), np.append(P, T)
+    else:
+        F, p = _integrator_varying(level, len(t), rtol_scale, base), np.append(P, [T, 0.0])
+        S = _signals_at(_base_signals(base)[2], t)
     c0 = time.process_time()
     try:
-        Y = np.array(F(x0=y0, p=np.append(P, T))["xf"]).T
+        Y = np.array(F(x0=y0, p=p)["xf"]).T
     except RuntimeError:
-        raise _why_stopped(level, P, y0, T, rtol_scale) from None
+        raise _why_stopped(level, P, y0, T, rtol_scale, base) from None
     seconds = time.process_time() - c0
     Y = np.vstack([y0, Y]) if len(t) != Y.shape[0] else Y
     if level in ("full", "rigorous"):
         alpha, beta = Y[:, 0], Y[:, 1]
         xy = nf.image_point(P, np.stack([alpha, beta], axis=-1))
         x, y = xy[:, 0], xy[:, 1]
-        if level == "full":
+        if level == "full" and base is not None:
+            H = nf.rotor_momentum_varying(P, Y[:, :3], Y[:, 3:], S)[:, 0]
+        elif level == "full":
             H = nf.rotor_momentum(P, Y[:, :3], Y[:, 3:])[:, 0]
         else:
             H = Y[:, 2]
@@ -222,8 +392,10 @@ def simulate(values: dict, t, level: str, rtol_scale: float = 1.0):
         which = "beta" if abs(cb[k]) < SINGULAR_COS or (k > 0 and np.sign(cb[k]) != np.sign(cb[k - 1])) else "alpha"
         raise Singular(f"{level}: {which} reaches +-90 deg by t = {t[k]:.6g} s, where (13) is singular "
                        "or the image point leaves the picture plane")
+    described = getattr(base, "describe", None)
     return ImagePointMotion(MODEL, level, named(values), t, np.asarray(x, float), np.asarray(y, float),
-                            np.asarray(alpha, float), np.asarray(beta, float), np.asarray(H, float), seconds)
+                            np.asarray(alpha, float), np.asarray(beta, float), np.asarray(H, float), seconds,
+                            base_rate=described() if callable(described) else None)
 
 
 def image_error(a, b) -> float:

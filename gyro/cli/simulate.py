@@ -10,9 +10,12 @@ steps of DOP853's tableau projected onto E = E(0)); E (2.3) along it. Parameters
 A B C J L I nu zeta eta lambda (lambda defaults to 1 + chi).
 
 `gyro simulate gimbal_precession --level {full,rigorous,image,small,elementary} --t-end T
-[--points N] [--set NAME=VALUE]... [--json] [--out FILE.png]`: the image point and the gimbal
-angles by one level of the precession hierarchy (docs/precession.md). JSON keys: model,
-level, params, t, x, y, alpha, beta (and H, seconds).
+[--points N] [--set NAME=VALUE]... [--base-rate NAME=AMP:FREQ[:PHASE]]... [--json] [--out
+FILE.png]`: the image point and the gimbal angles by one level of the precession hierarchy
+(docs/precession.md). `--base-rate eta=AMP:FREQ:PHASE` turns the base at
+u_eta(t) = u_eta + AMP sin(FREQ t + PHASE) (rad/s, rad/s, rad; NAME xi, eta or zeta;
+repeated, the terms add). JSON keys: model, level, params, t, x, y, alpha, beta (and H,
+seconds, and base_rate for a time-varying base).
 
 Parameters: the model's (`gyro params gimbal_gyroscope`) and the initial conditions
 theta0 dtheta0 dpsi0 dphi0 (rad, rad/s); psi(0) = phi(0) = 0. Every input is checked before
@@ -45,6 +48,9 @@ def register(sub) -> None:
                    help="gyrohorizoncompass: alpha, beta, gamma, epsilon - epsilon0 at t = 0, rad (default 0,0,0,0)")
     s.add_argument("--level", default=None, metavar="LEVEL",
                    help="gimbal_precession: full, rigorous, image, small or elementary (required)")
+    s.add_argument("--base-rate", action="append", default=None, metavar="NAME=AMP:FREQ[:PHASE]",
+                   help="gimbal_precession: a time-varying base, u_NAME(t) = u_NAME + AMP sin(FREQ t + PHASE) "
+                   "(NAME xi, eta or zeta; AMP, FREQ >= 0 in rad/s, PHASE in rad, default 0); repeatable")
     add_json(s)
     s.add_argument("--out", metavar="FILE.png", help="also plot the coordinates against t into FILE.png")
     s.set_defaults(run=run)
@@ -145,14 +151,28 @@ def _run_precession(args) -> int:
     if args.level not in precession.LEVELS:
         raise ParameterError(f"--level: unknown level {args.level!r}; known: {', '.join(precession.LEVELS)}")
     values = precession.parameters(parse_sets(args.set))
+    terms = [_oscillation(item) for item in args.base_rate or []]
+    base = precession.oscillating_base(values, terms) if terms else None
     t = _times(args)
     out = check_png_out(args.out) if args.out is not None else None
-    precession.initial_state(args.level, values)  # the initial angles away from +-90 deg
-    motion = precession.simulate(values, t, args.level)
+    precession.initial_state(args.level, values, base)  # the initial angles away from +-90 deg
+    motion = precession.simulate(values, t, args.level, base=base)
     if out is not None:
         motion.plot(out)
     print(json.dumps(motion.to_dict(), allow_nan=False) if args.json else motion.table())
     return 0
+
+
+def _oscillation(item: str):
+    """One --base-rate NAME=AMP:FREQ[:PHASE] as an Oscillation, or ParameterError naming it."""
+    from gyro.analyses import precession
+
+    label = f"--base-rate {item!r}"
+    name, sep, spec = item.partition("=")
+    parts = spec.split(":")
+    if not sep or not name.strip() or len(parts) not in (2, 3):
+        raise ParameterError(f"{label}: expected NAME=AMP:FREQ[:PHASE] (NAME xi, eta or zeta)")
+    return precession.oscillation(name.strip(), *parts, what=label)
 
 
 def run(args) -> int:
@@ -160,6 +180,8 @@ def run(args) -> int:
 
     from gyro.analyses.gimbal import trajectory
 
+    if args.base_rate is not None and args.model != "gimbal_precession":
+        raise ParameterError("--base-rate: only for gimbal_precession")
     if args.model == "gyrohorizoncompass":
         return _run_ghc(args)
     if args.model == "gimbal_precession":

@@ -25,17 +25,26 @@ class ImagePointMotion:
     H: np.ndarray
     seconds: float = 0.0  # CPU time of the integration
     changed: dict = field(default_factory=dict)
+    # a time-varying base: its description (the command line's {u_NAME: [{amplitude,
+    # frequency, phase}, ...]} about the parameters' constants); None for a constant base
+    base_rate: dict | None = None
 
     def to_dict(self) -> dict:
         """The `gyro simulate gimbal_precession --json` document (its keys are the contract;
         H and seconds are added)."""
-        return {"model": self.model, "level": self.level, "params": self.params, "t": self.t.tolist(),
-                "x": self.x.tolist(), "y": self.y.tolist(), "alpha": self.alpha.tolist(),
-                "beta": self.beta.tolist(), "H": self.H.tolist(), "seconds": self.seconds}
+        out = {"model": self.model, "level": self.level, "params": self.params, "t": self.t.tolist(),
+               "x": self.x.tolist(), "y": self.y.tolist(), "alpha": self.alpha.tolist(),
+               "beta": self.beta.tolist(), "H": self.H.tolist(), "seconds": self.seconds}
+        if self.base_rate is not None:
+            out["base_rate"] = self.base_rate
+        return out
 
     def table(self) -> str:
-        lines = [f"gimbal gyroscope on a rotating base ({self.model}), level {self.level}",
-                 f"{'t [s]':>12} {'x':>16} {'y':>16} {'alpha [rad]':>16} {'beta [rad]':>16} {'H [N m s]':>14}"]
+        lines = [f"gimbal gyroscope on a rotating base ({self.model}), level {self.level}"]
+        for name, terms in (self.base_rate or {}).items():
+            waves = " + ".join(f"{o['amplitude']:g} sin({o['frequency']:g} t + {o['phase']:g})" for o in terms)
+            lines.append(f"base rate {name}(t) = {name} + {waves} rad/s")
+        lines.append(f"{'t [s]':>12} {'x':>16} {'y':>16} {'alpha [rad]':>16} {'beta [rad]':>16} {'H [N m s]':>14}")
         for i in _shown_rows(len(self.t)):
             lines.append(f"{self.t[i]:>12.6g} {self.x[i]:>16.10g} {self.y[i]:>16.10g} {self.alpha[i]:>16.10g} "
                          f"{self.beta[i]:>16.10g} {self.H[i]:>14.9g}")

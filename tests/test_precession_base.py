@@ -91,7 +91,9 @@ def test_rigorous_approaches_full_at_first_order_in_1_over_H_on_a_turning_ship()
         base = pr.oscillating_base(v, SHIP)
         errs.append(pr.image_error(pr.simulate(v, t, "rigorous", base=base), pr.simulate(v, t, "full", base=base)))
     assert 2**-1.05 < errs[1] / errs[0] < 2**-0.95
-    assert errs[0] < 1e-3  # and small: the precession theory holds on the ship
+    # and small: the precession theory holds on the ship (measured 7.3e-5; without the u'
+    # terms of the full level's u_eta and u_zeta it is 4.3e-4, found in review)
+    assert errs[0] < 1.5e-4
 
 
 def _turning(z0, t, c, g_terms):
@@ -113,7 +115,7 @@ def _turning(z0, t, c, g_terms):
 def test_elementary_theory_on_a_rolling_and_pitching_base_is_its_closed_form():
     """No moments: H v = 0, the image point stays fixed in space while the base turns under it,
     so it drifts at -u x r in the base: with u_zeta = c, u_eta = e0 + A sin(w t + phase),
-    u_xi = B sin(w2 t), g = -u_eta + i u_xi (_turning). Measured ~1e-14 of the motion."""
+    u_xi = B sin(w2 t), g = -u_eta + i u_xi (_turning). Measured 4.0e-11 of the motion."""
     c, e0, A, w, ph, Bx, w2 = 0.05, 1e-3, 2e-3, 0.3, 0.4, 1.5e-3, 0.8
     v = pr.parameters({**NO_MOMENTS, "u_zeta": c, "u_eta": e0, "alpha0": 0.05, "beta0": -0.03})
     t = np.linspace(0, 20, 401)
@@ -123,7 +125,7 @@ def test_elementary_theory_on_a_rolling_and_pitching_base_is_its_closed_form():
     z = _turning(x0 + 1j * y0, t, c, [(-e0, 0, 0), (-A, w, ph), (1j * Bx, w2, 0.0)])
     scale = np.abs(z - z[0]).max()
     assert scale > 0.02  # the point moves
-    assert np.abs(m.x + 1j * m.y - z).max() < 1e-9 * scale
+    assert np.abs(m.x + 1j * m.y - z).max() < 1e-10 * scale  # measured 4.0e-11: CVODES at rtol 1e-12 over 20 s
 
 
 def test_elementary_theory_on_a_yawing_base_turns_the_image_point_by_the_yaw_angle():
@@ -136,7 +138,7 @@ def test_elementary_theory_on_a_yawing_base_turns_the_image_point_by_the_yaw_ang
     m = pr.simulate(v, t, "elementary", base=pr.oscillating_base(v, [pr.oscillation("zeta", A, w, ph)]))
     z0 = complex(np.tan(0.2) / np.cos(0.1), -np.tan(0.1))
     z = z0 * np.exp(-1j * (c * t + A / w * (np.cos(ph) - np.cos(w * t + ph))))
-    assert np.abs(m.x + 1j * m.y - z).max() < 1e-9 * abs(z0)
+    assert np.abs(m.x + 1j * m.y - z).max() < 1e-10 * abs(z0)  # measured 9.4e-12
 
 
 def test_full_level_conserves_the_gimbals_momentum_about_its_axis_on_a_rolling_base():
@@ -259,3 +261,77 @@ def test_a_motion_to_beta_90_deg_on_a_turning_base_is_refused_where_it_gets_ther
     ue = pr.parameters()["u_eta"]
     root = brentq(lambda s: (0.1 - ue) * s - A * (1 - np.cos(w * s)) / w - np.pi / 2, 1, 40)
     assert abs(t_stop - root) < 0.01
+
+
+AMP = [0.05]
+
+
+def test_a_base_is_integrated_as_it_is_now_not_as_it_was():
+    """Integrators are kept by the base's expression to the last bit, never by the function's
+    identity: a function reading a value that changes between calls gives the new motion
+    (found in review: it kept the first one), and an object that cannot be hashed works."""
+    from dataclasses import dataclass
+
+    v = pr.parameters(NO_MOMENTS)
+    t = np.linspace(0, 5, 11)
+
+    def base(s):
+        return (AMP[0] * np.sin(s), 0.0, 0.0)
+
+    first = pr.simulate(v, t, "rigorous", base=base)
+    AMP[0] = 0.0
+    second = pr.simulate(v, t, "rigorous", base=base)
+    AMP[0] = 0.05
+    constant = pr.simulate(v, t, "rigorous")
+    assert np.abs(first.y - constant.y).max() > 1e-2
+    assert np.array_equal(second.y, constant.y)
+
+    @dataclass
+    class Roll:  # unhashable (eq without frozen)
+        amp: float
+
+        def __call__(self, s):
+            return (self.amp * np.sin(s), 0.0, 0.0)
+
+    r = Roll(0.05)
+    assert np.array_equal(pr.simulate(v, t, "rigorous", base=r).y, first.y)
+    r.amp = 0.0
+    assert np.array_equal(pr.simulate(v, t, "rigorous", base=r).y, constant.y)
+    # 0.1 and 0.1 + 1e-15 print alike; the key tells them apart
+    a = pr.simulate(v, t, "rigorous", base=lambda s: (0.1 * np.sin(s), 0.0, 0.0))
+    b = pr.simulate(v, t, "rigorous", base=lambda s: ((0.1 + 1e-13) * np.sin(s), 0.0, 0.0))
+    assert not np.array_equal(a.y, b.y)
+
+
+@pytest.mark.parametrize("jump", [lambda s: np.heaviside(s - 1, 0.5), lambda s: np.where(s > 1, 1.0, 0.0),
+                                  lambda s: np.floor(s), lambda s: np.mod(s, 1.0), lambda s: np.sign(s - 1)])
+def test_a_base_that_jumps_is_refused(jump):
+    """A step's derivative is an impulse, which CasADi's derivative of a step (0) loses: the
+    full level would integrate a base without it (found in review: a heaviside step gave
+    beta(5) = 4.4e-7 where a tanh step of width 1e-3 gives 1e-13). Refused in one line."""
+    v = pr.parameters(NO_MOMENTS)
+    with pytest.raises(ParameterError, match="jumps"):
+        pr.simulate(v, np.linspace(0, 5, 3), "full", base=lambda s: (0.0, 1e-3 * jump(s), 0.0))
+    pr.simulate(v, np.linspace(0, 1, 3), "rigorous", base=lambda s: (0.0, 1e-3 * np.abs(np.sin(s)), 0.0))  # kinks are smooth enough
+
+
+@pytest.mark.parametrize("level", ["rigorous", "full", "image"])
+def test_a_motion_through_90_deg_between_two_asked_times_is_refused(level):
+    """alpha passes -90 deg and comes back between the two asked times 0 and 2 pi (a roll of
+    2 rad/s): every level refuses it, as the image level did, because the motion is checked
+    on a denser grid than asked (found in review: rigorous and full exited 0)."""
+    v = pr.parameters(NO_MOMENTS)
+    base = pr.oscillating_base(v, [pr.oscillation("xi", 2.0, 1.0)])
+    with pytest.raises(pr.Singular):
+        pr.simulate(v, np.array([0.0, 2 * np.pi]), level, base=base)
+
+
+def test_uneven_output_times_are_answered_at_those_times():
+    """The output times need not be evenly spaced (found in review: t = [0, 0.1, 1, 5] gave
+    alpha(0.1) = -0.055 where the motion has -0.00025)."""
+    v = pr.parameters({"l_x": 1e-3, "alpha0": 0.0, "beta0": 0.0})
+    fine = pr.simulate(v, np.linspace(0, 5, 51), "rigorous")
+    coarse = pr.simulate(v, np.array([0.0, 0.1, 1.0, 5.0]), "rigorous")
+    assert np.allclose(coarse.alpha, fine.alpha[[0, 1, 10, 50]], rtol=1e-9, atol=1e-15)
+    with pytest.raises(ParameterError, match="increase"):
+        pr.simulate(v, np.array([0.0, 1.0, 0.5]), "rigorous")

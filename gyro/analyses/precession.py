@@ -80,10 +80,11 @@ def named(values: dict) -> dict:
     return {cli_name(k): float(v) for k, v in values.items()}
 
 
-@lru_cache(maxsize=None)
-def _integrator(level: str, n_out: int, rtol_scale: float = 1.0):
-    """A CVODES integrator of one level, parameters as its input p, outputs at n_out times
-    of a grid scaled by its input: y(s) for s in [0, 1] with dy/ds = T f(y)."""
+@lru_cache(maxsize=64)
+def _integrator(level: str, grid: tuple, steps: int, rtol_scale: float = 1.0):
+    """A CVODES integrator of one level, parameters as its input p, outputs at the times of
+    `grid` (in [0, 1]) scaled by its input: y(s) with dy/ds = T f(y); at most `steps` steps
+    between two output times."""
     import casadi as ca
 
     cf = load(MODEL).casadi
@@ -100,14 +101,36 @@ def _integrator(level: str, n_out: int, rtol_scale: float = 1.0):
         y = ca.SX.sym("y", 3)
         A, b = getattr(cf, f"{level}_system")(p, y[:2], y[2])
         rhs = ca.solve(A, b)
-    grid = list(np.linspace(0.0, 1.0, n_out))
-    # full: MAX_STEPS over the whole horizon, shared among the output intervals (CVODES
-    # counts per interval), so a runaway horizon stops after as many steps however many
-    # points are asked for
-    steps = max(500, MAX_STEPS // max(1, n_out - 1)) if level == "full" else MAX_STEPS_PRECESSION
-    opts = {"abstol": ATOL * rtol_scale, "reltol": RTOL * rtol_scale, "max_num_steps": steps, "linear_multistep_method": "adams",
-            "nonlinear_solver_iteration": "functional", "disable_internal_warnings": True}
-    return ca.integrator(f"F_{level}", "cvodes", {"x": y, "p": P, "ode": T * rhs}, 0.0, grid, opts)
+    return ca.integrator(f"F_{level}", "cvodes", {"x": y, "p": P, "ode": T * rhs}, 0.0, list(grid),
+                         _options(steps, rtol_scale))
+
+
+def _options(steps: int, rtol_scale: float) -> dict:
+    return {"abstol": ATOL * rtol_scale, "reltol": RTOL * rtol_scale, "max_num_steps": int(steps),
+            "linear_multistep_method": "adams", "nonlinear_solver_iteration": "functional",
+            "disable_internal_warnings": True}
+
+
+CHECK_POINTS = 1001  # the motion is checked for +-90 deg at these times of the horizon besides the asked ones
+
+
+def _steps(level: str, n: int) -> int:
+    """The step budget between two of n output times: full, MAX_STEPS over the whole horizon
+    shared among the intervals (CVODES counts per interval), so a runaway horizon stops
+    after as many steps however many points are asked for; the precession levels,
+    MAX_STEPS_PRECESSION per interval."""
+    return max(500, MAX_STEPS // max(1, n - 1)) if level == "full" else MAX_STEPS_PRECESSION
+
+
+def _check_grid(t: np.ndarray):
+    """(grid, where) of the check: the asked times t / T with CHECK_POINTS evenly spaced ones
+    among them (a motion that passes +-90 deg and returns between two asked times is seen
+    there), and where the asked times are in it; None where t is as dense already."""
+    asked = t / float(t[-1])
+    if len(t) >= CHECK_POINTS:
+        return None
+    grid = np.union1d(asked, np.linspace(0.0, 1.0, CHECK_POINTS))
+    return tuple(float(g) for g in grid), np.searchsorted(grid, asked)
 
 
 @dataclass(frozen=True)
@@ -166,11 +189,18 @@ def oscillating_base(values: dict, terms) -> OscillatingBase:
     return OscillatingBase(tuple(float(values[b]) for b in BASE), tuple(terms))
 
 
-@lru_cache(maxsize=16)
+# CasADi operations that make a function of t jump (a step, a comparison, a branch, a
+# sawtooth): their derivative is taken as 0, so the impulse u' of a jump would be lost
+_JUMPS = ("OP_LT", "OP_LE", "OP_EQ", "OP_NE", "OP_NOT", "OP_AND", "OP_OR", "OP_IF_ELSE_ZERO", "OP_FLOOR",
+          "OP_CEIL", "OP_FMOD", "OP_REMAINDER", "OP_SIGN", "OP_COPYSIGN")
+
+
 def _base_signals(base):
     """(t, the rungs of the model's time-varying parameters as a CasADi SX column in the
     emitted order (metadata 'varying': each value, then its derivatives), a Function of t
-    giving them): base(t) evaluated on a symbol, its derivatives exact."""
+    giving them, the Function serialised: the key of its integrators): base(t) evaluated
+    on a symbol, its derivatives exact. A base that jumps (a step, a comparison, floor,
+    mod, sign) is refused: its derivative would be 0 where it is an impulse."""
     import casadi as ca
 
     t = ca.SX.sym("t")
@@ -193,7 +223,13 @@ def _base_signals(base):
             r = ca.jacobian(r, t)
             rungs.append(r)
     col = ca.densify(ca.vertcat(*rungs))
-    return t, col, ca.Function("base_rate", [t], [col])
+    fun = ca.Function("base_rate", [t], [col])
+    values = ca.Function("base_value", [t], u)
+    jumps = {getattr(ca, name) for name in _JUMPS if hasattr(ca, name)}
+    if any(values.instruction_id(k) in jumps for k in range(values.n_instructions())):
+        raise ParameterError("base: the base rate jumps (a step, comparison, branch, floor, mod or sign of t): "
+                             "its derivative, an impulse, would be lost; write it as a smooth function of t")
+    return t, col, fun, fun.serialize()
 
 
 def base_rungs(base, t) -> np.ndarray:
@@ -211,18 +247,29 @@ def _signals_at(fun, t) -> np.ndarray:
     return out
 
 
-@lru_cache(maxsize=16)
-def _integrator_varying(level: str, n_out: int, rtol_scale: float, base):
-    """As `_integrator` with the base rate base(t) in the emitted `*_varying` functions: the
-    input p is (parameters, the horizon T, the start time t0), t = t0 + T s."""
+_VARYING: dict = {}
+
+
+def _integrator_varying(level: str, grid: tuple, steps: int, rtol_scale: float, signals):
+    """As `_integrator` with the base rate in the emitted `*_varying` functions, `signals`
+    its `_base_signals`: the input p is (parameters, the horizon T, the start time t0),
+    t = t0 + T s. Integrators are kept by the base's expression to the last bit (its
+    serialised form), never by the function's identity: a function whose result changes
+    between calls (a global, a mutable object) is integrated as it is now."""
     import casadi as ca
+
+    key = (level, grid, steps, rtol_scale, signals[3])
+    if key in _VARYING:
+        return _VARYING[key]
+    if len(_VARYING) >= 16:
+        _VARYING.clear()
 
     cf = load(MODEL).casadi
     npar = len(load(MODEL).param_names)
     P = ca.SX.sym("P", npar + 2)
     p, T, t0 = P[:npar], P[npar], P[npar + 1]
     s = ca.SX.sym("s")
-    tb, col, _ = _base_signals(base)
+    tb, col = signals[0], signals[1]
     sig = ca.substitute(col, tb, t0 + T * s)
     if level == "full":
         from gyro import ode
@@ -234,11 +281,10 @@ def _integrator_varying(level: str, n_out: int, rtol_scale: float, base):
         y = ca.SX.sym("y", 3)
         A, b = getattr(cf, f"{level}_system_varying")(p, y[:2], y[2], sig)
         rhs = ca.solve(A, b)
-    grid = list(np.linspace(0.0, 1.0, n_out))
-    steps = max(500, MAX_STEPS // max(1, n_out - 1)) if level == "full" else MAX_STEPS_PRECESSION
-    opts = {"abstol": ATOL * rtol_scale, "reltol": RTOL * rtol_scale, "max_num_steps": steps, "linear_multistep_method": "adams",
-            "nonlinear_solver_iteration": "functional", "disable_internal_warnings": True}
-    return ca.integrator(f"F_{level}_varying", "cvodes", {"x": y, "t": s, "p": P, "ode": T * rhs}, 0.0, grid, opts)
+    F = ca.integrator(f"F_{level}_varying", "cvodes", {"x": y, "t": s, "p": P, "ode": T * rhs}, 0.0, list(grid),
+                      _options(steps, rtol_scale))
+    _VARYING[key] = F
+    return F
 
 
 def rates(level: str, P, state2, H_now, signals=None) -> np.ndarray:
@@ -297,12 +343,12 @@ def _why_stopped(level: str, P, y0, T: float, rtol_scale: float = 1.0, base=None
                                  f"{MAX_STEPS:.3g} steps over the horizon, or a failed step)")
     nf = load(MODEL).numpy
     if base is None:
-        F = _integrator(level, 2, rtol_scale)
+        F = _integrator(level, (0.0, 1.0), _steps(level, 2), rtol_scale)
 
         def inputs(dt, _t0):
             return np.append(P, dt)
     else:
-        F = _integrator_varying(level, 2, rtol_scale, base)
+        F = _integrator_varying(level, (0.0, 1.0), _steps(level, 2), rtol_scale, _base_signals(base))
 
         def inputs(dt, t0):
             return np.append(P, [dt, t0])
@@ -351,22 +397,39 @@ def simulate(values: dict, t, level: str, rtol_scale: float = 1.0, base=None):
     if level not in LEVELS:
         raise ParameterError(f"--level: unknown level {level!r} of {MODEL}; known: {', '.join(LEVELS)}")
     t = np.asarray(t, float)
+    if t.ndim != 1 or t.size < 2 or t[0] != 0 or not np.all(np.diff(t) > 0) or not np.isfinite(t[-1]):
+        raise ParameterError("t: the output times must start at 0 and increase, at least two of them")
     nf = load(MODEL).numpy
     P = vector(values)
     y0 = initial_state(level, values, base)
     T = float(t[-1])
-    if base is None:
-        F, p = _integrator(level, len(t), rtol_scale), np.append(P, T)
-    else:
-        F, p = _integrator_varying(level, len(t), rtol_scale, base), np.append(P, [T, 0.0])
-        S = _signals_at(_base_signals(base)[2], t)
+    grid, steps = tuple(float(g) for g in t / T), _steps(level, len(t))
+    signals = None if base is None else _base_signals(base)
+
+    def integrate(grid, steps):
+        if base is None:
+            F, p = _integrator(level, grid, steps, rtol_scale), np.append(P, T)
+        else:
+            F, p = _integrator_varying(level, grid, steps, rtol_scale, signals), np.append(P, [T, 0.0])
+        try:
+            Y = np.array(F(x0=y0, p=p)["xf"]).T
+        except RuntimeError:
+            raise _why_stopped(level, P, y0, T, rtol_scale, base) from None
+        return np.vstack([y0, Y]) if len(grid) != Y.shape[0] else Y
+
     c0 = time.process_time()
-    try:
-        Y = np.array(F(x0=y0, p=p)["xf"]).T
-    except RuntimeError:
-        raise _why_stopped(level, P, y0, T, rtol_scale, base) from None
+    Y = integrate(grid, steps)
     seconds = time.process_time() - c0
-    Y = np.vstack([y0, Y]) if len(t) != Y.shape[0] else Y
+    where = np.arange(len(t))
+    check = _check_grid(t)
+    if check is not None:  # the same motion on a denser grid, checked there (its time not the level's cost)
+        grid, where = check
+        Yc = integrate(grid, _steps(level, len(grid)) if level == "full" else steps)
+        Yc[where] = Y  # the answer is the asked grid's run, to its last bit
+        Y = Yc
+    tg = np.asarray(grid) * T  # the motion on the whole grid, checked there; answered at t
+    if signals is not None:
+        S = _signals_at(signals[2], tg)
     if level in ("full", "rigorous"):
         alpha, beta = Y[:, 0], Y[:, 1]
         xy = nf.image_point(P, np.stack([alpha, beta], axis=-1))
@@ -390,11 +453,11 @@ def simulate(values: dict, t, level: str, rtol_scale: float = 1.0, base=None):
     if bad.size:
         k = bad[0]
         which = "beta" if abs(cb[k]) < SINGULAR_COS or (k > 0 and np.sign(cb[k]) != np.sign(cb[k - 1])) else "alpha"
-        raise Singular(f"{level}: {which} reaches +-90 deg by t = {t[k]:.6g} s, where (13) is singular "
+        raise Singular(f"{level}: {which} reaches +-90 deg by t = {tg[k]:.6g} s, where (13) is singular "
                        "or the image point leaves the picture plane")
     described = getattr(base, "describe", None)
-    return ImagePointMotion(MODEL, level, named(values), t, np.asarray(x, float), np.asarray(y, float),
-                            np.asarray(alpha, float), np.asarray(beta, float), np.asarray(H, float), seconds,
+    x, y, alpha, beta, H = (np.asarray(v, float)[where] for v in (x, y, alpha, beta, H))
+    return ImagePointMotion(MODEL, level, named(values), t, x, y, alpha, beta, H, seconds,
                             base_rate=described() if callable(described) else None)
 
 

@@ -68,9 +68,12 @@ def _casadi_function(model: Model):
 
 @lru_cache(maxsize=None)
 def _emitted_positions(model: Model):
-    """(rows, cols) of the values of the emitted dMDK, its structural nonzeros (metadata.json)."""
+    """(rows, cols) of the values of the emitted dMDK, its structural nonzeros (metadata.json),
+    or None for a model folder emitted before outputs could be sparse (its dMDK a matrix)."""
     o = next(o for o in model.meta["functions"]["operator_sensitivity"]["outputs"] if o["name"] == "dMDK")
-    return np.array(o["nonzeros"]["rows"]), np.array(o["nonzeros"]["cols"])
+    if "nonzeros" not in o:
+        return None
+    return (np.asarray(o["nonzeros"]["rows"], dtype=np.intp), np.asarray(o["nonzeros"]["cols"], dtype=np.intp))
 
 
 def sparse_partials(model: Model, P: np.ndarray, qe: np.ndarray, route: str = "auto"):
@@ -83,7 +86,11 @@ def sparse_partials(model: Model, P: np.ndarray, qe: np.ndarray, route: str = "a
     if route == "emitted":
         with np.errstate(all="ignore"):
             vals, dr = function(model, "operator_sensitivity")(P, qe)
-        return (vals, *_emitted_positions(model), dr)
+        where = _emitted_positions(model)
+        if where is None:  # a dense dMDK: every entry a position
+            rows, cols = np.indices(vals.shape[1:]).reshape(2, -1)
+            return vals.reshape(vals.shape[0], -1), rows.astype(np.intp), cols.astype(np.intp), dr
+        return (vals, *where, dr)
     if route != "casadi":
         raise ValueError(f"route: 'auto', 'emitted' or 'casadi', got {route!r}")
     N = P.shape[0]

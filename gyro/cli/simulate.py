@@ -50,7 +50,7 @@ def register(sub) -> None:
                    help="gimbal_precession: full, rigorous, image, small or elementary (required)")
     s.add_argument("--base-rate", action="append", default=None, metavar="NAME=AMP:FREQ[:PHASE]",
                    help="gimbal_precession: a time-varying base, u_NAME(t) = u_NAME + AMP sin(FREQ t + PHASE) "
-                   "(NAME xi, eta or zeta; AMP, FREQ >= 0 in rad/s, PHASE in rad, default 0); repeatable")
+                   "(NAME xi, eta or zeta; AMP in rad/s, FREQ >= 0 in rad/s, PHASE in rad, default 0); repeatable")
     add_json(s)
     s.add_argument("--out", metavar="FILE.png", help="also plot the coordinates against t into FILE.png")
     s.set_defaults(run=run)

@@ -82,3 +82,22 @@ def test_a_tolerance_study_on_dask_is_the_in_process_one(cluster):
     a = tolerance(tg, tg.defaults, spreads, 700, seed=3, size=256)
     b = tolerance(tg, tg.defaults, spreads, 700, seed=3, scheduler=cluster, size=100)
     assert a.to_dict() == b.to_dict()
+
+
+def test_maps_and_campbell_diagrams_on_dask_are_the_in_process_ones(cluster):
+    """The stability map and the Campbell diagram run their batch on the sweep executor when
+    given a scheduler, to the bit the in-process answer (the budgeted in-process batch)."""
+    from gyro.analyses.campbell import campbell
+    from gyro.analyses.stability_map import stability_grid
+
+    tg = load(MODEL)
+    v = tg.parameters({})
+    here = stability_grid(tg, v, "H", (0.1, 0.6), "Kp", (1e5, 1e6), 6)
+    there = stability_grid(tg, v, "H", (0.1, 0.6), "Kp", (1e5, 1e6), 6, scheduler=cluster)
+    assert np.array_equal(here.label, there.label) and np.array_equal(here.growth, there.growth, equal_nan=True)
+    assert here.to_dict() == there.to_dict()
+    spins = np.linspace(0.05, 0.5, 9)
+    a = campbell(tg, v, "H", spins, harmonics=(1, 2))
+    b = campbell(tg, v, "H", spins, harmonics=(1, 2), scheduler=cluster)
+    assert np.array_equal(a.exact.frequencies, b.exact.frequencies)
+    assert a.to_dict() == b.to_dict()

@@ -32,17 +32,23 @@ class SweepBudget(RuntimeError):
 
 
 def batch_default(model: Model, P: np.ndarray, progress=False, desc="default", budget: float | None = BUDGET,
-                  watch: float = WATCH) -> Spectrum:
+                  watch: float = WATCH, scheduler=None) -> Spectrum:
     """The default method over a large batch, in chunks (1 set first, growing to CHUNK; one
     at a time once sets cost over 0.25 s, as escalating ones do), with a progress bar. Once
     `watch` seconds have passed, a sweep whose projected time (the rate so far times the
     sets) exceeds max(budget, 20 x the batch's cost at the default method's measured rate)
     stops with SweepBudget, one line saying how far it got: a range over 300 decades stops
-    in seconds, not after 15 minutes."""
+    in seconds, not after 15 minutes. With a `scheduler` (gyro.executor: 'local', an address
+    or a Client) the batch runs on Dask in the sweep executor's chunks instead, without the
+    budget: the user has chosen the scale."""
     import time
 
     from gyro.methods import get
 
+    if scheduler is not None:  # on Dask, in the sweep executor's chunks (the bits of this process's run)
+        from gyro.analyses.sweep import spectra
+
+        return spectra(model, P, "default", scheduler, progress, desc)
     limit = None if budget is None else max(budget, 20 * len(P) * get("default").COST)
     t0, first, warm, parts, start, size = time.perf_counter(), 0, 0.0, [], 0, 1
     bar = None
@@ -174,7 +180,7 @@ def crossings(model: Model, base: np.ndarray, spin: str, values, rate, lam, harm
 
 
 def campbell(model: Model, values: dict, spin: str | None, sweep_values, harmonics=(), progress=False,
-             log=False) -> CampbellDiagram:
+             log=False, scheduler=None) -> CampbellDiagram:
     """The Campbell diagram over the spin parameter's `sweep_values` (absolute, in its unit),
     the other parameters at `values`."""
     spin = spin_parameter(model, spin)
@@ -183,7 +189,7 @@ def campbell(model: Model, values: dict, spin: str | None, sweep_values, harmoni
     P[:, model.param_names.index(spin)] = x
     for v in (x[0], x[-1]):
         model.parameters({spin: v})  # the ends of the range are valid values
-    exact = batch_default(model, P, progress, desc="Campbell")
+    exact = batch_default(model, P, progress, desc="Campbell", scheduler=scheduler)
     qe = exact.equilibrium if exact.equilibrium is not None else equilibria(model, P)[0]
     M, D, K = operators(model, P, qe)
     lam = exact.growth + 1j * exact.frequencies
@@ -216,11 +222,12 @@ def _rate_label(model: Model, spin: str) -> str:
 
 
 def sweep(model: Model, values: dict, lo: float, hi: float, points: int, progress=False, spin=None,
-          harmonics=()) -> CampbellDiagram:
+          harmonics=(), scheduler=None) -> CampbellDiagram:
     """Frequencies against spin: the spin parameter from lo to hi times the set's value
     (log-spaced)."""
     spin = spin_parameter(model, spin)
     if values[spin] <= 0:
         raise ParameterError(f"{spin}: --range scales the set's {spin}, which is {values[spin]:g}; give "
                              f"{spin} > 0 or an absolute --spin-range")
-    return campbell(model, values, spin, values[spin] * np.geomspace(lo, hi, points), harmonics, progress, log=True)
+    return campbell(model, values, spin, values[spin] * np.geomspace(lo, hi, points), harmonics, progress, log=True,
+                    scheduler=scheduler)

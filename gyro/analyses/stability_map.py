@@ -9,15 +9,16 @@ from gyro.results import StabilityMap, classify
 
 
 def stability_grid(model: Model, values: dict, xname, xrange, yname, yrange, points, progress=False,
-                   xlog=False, ylog=False) -> StabilityMap:
-    """Stability over a grid of two parameters (log-spaced where asked)."""
+                   xlog=False, ylog=False, scheduler=None) -> StabilityMap:
+    """Stability over a grid of two parameters (log-spaced where asked); on Dask with a
+    `scheduler` (gyro.executor), to the bit the in-process map."""
     xs = (np.geomspace if xlog else np.linspace)(*xrange, points)
     ys = (np.geomspace if ylog else np.linspace)(*yrange, points)
     X, Y = np.meshgrid(xs, ys)
     P = np.tile(model.vector(values), (X.size, 1))
     P[:, model.param_names.index(xname)] = X.ravel()
     P[:, model.param_names.index(yname)] = Y.ravel()
-    st = classify(batch_default(model, P, progress, desc="stability map"))
+    st = classify(batch_default(model, P, progress, desc="stability map", scheduler=scheduler))
     return StabilityMap(model.name, model.meta["title"], {p.name: p.unit for p in model.params},
                         xs, ys, xname, yname, st.label.reshape(X.shape), st.growth_rate.reshape(X.shape),
                         st.unstable_roots.reshape(X.shape), st.slowest_growth.reshape(X.shape), xlog, ylog,

@@ -6,8 +6,8 @@ import json
 import math
 import sys
 
-from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_set, check_png_out,
-                             model_with_equilibrium, parse_sets)
+from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_scheduler, add_set,
+                             check_png_out, model_with_equilibrium, parse_sets)
 from gyro.errors import ParameterError
 
 ORDER = 20
@@ -32,6 +32,7 @@ def register(sub) -> None:
                    help="lines k x spin rate, and their crossings with the modes (critical speeds)")
     add_points(c, 200, "spins in the sweep (default: 200)")
     add_quiet(c)
+    add_scheduler(c)
     c.set_defaults(run=run)
 
 
@@ -78,9 +79,10 @@ def run(args) -> int:
     out = check_png_out(args.out) if args.out else None
     progress = not args.quiet and sys.stderr.isatty()
     if args.spin_range is not None:
-        diagram = campbell(model, values, spin, np.linspace(lo, hi, args.points), ks, progress)
+        diagram = campbell(model, values, spin, np.linspace(lo, hi, args.points), ks, progress,
+                           scheduler=args.scheduler)
     else:
-        diagram = sweep(model, values, lo, hi, args.points, progress, spin, ks)
+        diagram = sweep(model, values, lo, hi, args.points, progress, spin, ks, scheduler=args.scheduler)
     if out is not None:
         diagram.plot(out)
     if args.json:

@@ -8,8 +8,8 @@ import json
 import math
 import sys
 
-from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_set, check_png_out,
-                             model_with_equilibrium, parse_sets)
+from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_scheduler, add_set,
+                             check_png_out, model_with_equilibrium, parse_sets)
 from gyro.errors import ParameterError
 
 ORDER = 30
@@ -32,6 +32,7 @@ def register(sub) -> None:
     add_out(s)
     add_json(s)
     add_quiet(s)
+    add_scheduler(s)
     s.set_defaults(run=run)
 
 
@@ -54,7 +55,8 @@ def run(args) -> int:
         raise ParameterError(f"--points: need 2..{MAX_POINTS} per axis, got {args.points}")
     out = check_png_out(args.out)
     grid = stability_grid(model, values, args.x, args.x_range, args.y, args.y_range,
-                          args.points, progress=not args.quiet and sys.stderr.isatty(), xlog=args.x_log, ylog=args.y_log)
+                          args.points, progress=not args.quiet and sys.stderr.isatty(), xlog=args.x_log, ylog=args.y_log,
+                          scheduler=args.scheduler)
     grid.plot(out)
     print(json.dumps(grid.to_dict(), allow_nan=False) if args.json else grid.summary(out))
     return 0

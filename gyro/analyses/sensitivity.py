@@ -283,6 +283,9 @@ def sensitivities(model: Model, P, spec: Spectrum | None = None, method: str = "
                   route: str = "auto") -> Sensitivities:
     """d omega_i / d p_j for every set (rows of P), frequency and parameter; the spectrum
     by `method` unless given."""
+    if model.meta.get("momenta"):  # its reference moves with p through the momenta too: not derived
+        raise ValueError(f"{model.name}: its operator depends on the momenta {', '.join(model.meta['momenta'])} "
+                         "of a stationary motion; sensitivities cover models with a relative equilibrium")
     P = ladder.as_batch(model, P)
     if spec is None:
         spec = ladder.spectrum(model, P, method)

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from gyro import load
-from gyro.analyses.forced import cases, linear_error, nonlinear_response, spin_torque
+from gyro.analyses.forced import cases, harmonic_balance, linear_error, nonlinear_response, spin_torque
 
 RESULTS = Path(__file__).resolve().parent / "results"
 # the integration's tolerance and the shooting's periodicity: the error measured is then
@@ -60,6 +60,22 @@ def measure(model, values, harmonic, a, start=None):
     print(f"  a = {a:.6g} N: error {row['error']:.5g}, set by {row['worst_coordinate']} "
           f"({row['newton_steps']} Newton steps, "
           f"residual {row['residual']:.2g}, {row['seconds']:.1f} s)", flush=True)
+    # the same response by harmonic balance (an independent method), and its first Newton
+    # step's estimate of the linear response's error
+    t0 = time.perf_counter()
+    try:
+        Xh, _, hb = harmonic_balance(model, values, (s, k, a, phi))
+    except RuntimeError as exc:  # recorded as it is, never an unconverged number
+        row["harmonic_balance"] = {"failed": str(exc), "seconds": time.perf_counter() - t0}
+        print(f"    harmonic balance: {exc}", flush=True)
+    else:
+        row["harmonic_balance"] = {"error": linear_error(Xh, Xl, units), "first_correction": hb["first_correction"],
+                                   "newton_steps": hb["newton_steps"], "residual": hb["residual"],
+                                   "seconds": time.perf_counter() - t0,
+                                   "against_shooting": float(np.max(np.abs(Xh - Xn)) / np.max(np.abs(Xl)))}
+        print(f"    harmonic balance: error {row['harmonic_balance']['error']:.8g} (shooting {row['error']:.8g}), "
+              f"first step's estimate {hb['first_correction']:.5g}, {hb['newton_steps']} Newton steps, "
+              f"{row['harmonic_balance']['seconds']:.1f} s", flush=True)
     row["z"] = info["continuation"]["z"]
     return row, info["continuation"]
 

@@ -172,6 +172,45 @@ def _spin_free_rate(values: dict, g: dict, gd: dict) -> float:
     return float((R.T @ (p + gd["gamma1"] * np.array([0, 0, 1.0])) + gd["gamma2"] * np.array([1.0, 0, 0]))[1])
 
 
+class _Periodic:
+    """What the periodic responses to one harmonic share: the set P (and its values), the
+    equilibrium qe, the forcing frequency w = k omega_c and period T, the linear response
+    X_lin, the coordinates (11) and the reduced ones' indices ri (10), gamma3's index k3, the
+    equilibrium as all 11 coordinates q_ref; `state(x, xd)` the full state (q, q') of the
+    reduced coordinates' displacements x and rates xd about it, gamma3's rate from the
+    integral C r2 = H."""
+
+    def __init__(self, model: Model, values: dict, harmonic):
+        from gyro.equilibrium import equilibrium
+
+        _check_model(model)
+        s, k, a, phi = harmonic
+        self.P = model.vector(values)
+        self.values = model.parameters(values)
+        self.qe = equilibrium(model, self.P)
+        self.w = k * float(spin_rate(model, self.P[None], self.qe[None])[0])
+        self.T = 2 * np.pi / self.w
+        u = np.zeros(3, complex)
+        u[s - 1] = -1j * a * np.exp(1j * phi)
+        self.X_lin = harmonic_response(model, self.P, self.w, u, qe=self.qe[None]).X[0]
+        self.coords = model.meta["coordinates"]
+        self.ri = np.array([self.coords.index(c) for c in model.meta["reduced"]])
+        self.nq, self.n = len(self.coords), len(self.ri)
+        self.k3 = self.coords.index("gamma3")
+        self.q_ref = np.zeros(self.nq)
+        for name, v in zip(model.meta["equilibrium_coordinates"], self.qe):
+            self.q_ref[self.coords.index(name)] = v
+
+    def state(self, x, xd) -> np.ndarray:
+        q = self.q_ref.copy()
+        q[self.ri] += x
+        qd = np.zeros(self.nq)
+        qd[self.ri] = xd
+        g, gd = dict(zip(self.coords, q)), dict(zip(self.coords, qd))
+        qd[self.k3] = self.values["H"] / self.values["C"] - _spin_free_rate(self.values, g, gd)
+        return np.concatenate([q, qd])
+
+
 def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12, max_newton: int = 12,
                        periodic_tol: float | None = None, start: dict | None = None, halvings: int = 6):
     """The steady (periodic) response of the full 11-coordinate equations (the emitted
@@ -200,26 +239,11 @@ def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12
     from scipy.integrate import solve_ivp
 
     from gyro import ode
-    from gyro.equilibrium import equilibrium
 
-    _check_model(model)
+    S = _Periodic(model, values, harmonic)
     s, k, a, phi = harmonic
-    P = model.vector(values)
-    values = model.parameters(values)
-    qe = equilibrium(model, P)
-    W = float(spin_rate(model, P[None], qe[None])[0])
-    w = k * W
-    T = 2 * np.pi / w
-    u = np.zeros(3, complex)
-    u[s - 1] = -1j * a * np.exp(1j * phi)
-    X_lin = harmonic_response(model, P, w, u, qe=qe[None]).X[0]
-    coords, reduced = model.meta["coordinates"], model.meta["reduced"]
-    ri = np.array([coords.index(c) for c in reduced])
-    nq, n = len(coords), len(ri)
-    k3 = coords.index("gamma3")
-    q_ref = np.zeros(nq)
-    for name, v in zip(model.meta["equilibrium_coordinates"], qe):
-        q_ref[coords.index(name)] = v
+    P, values, w, T, X_lin = S.P, S.values, S.w, S.T, S.X_lin
+    coords, ri, nq, n, k3, q_ref = S.coords, S.ri, S.nq, S.n, S.k3, S.q_ref
     zero3 = np.zeros(3)
 
     def given(t):
@@ -235,13 +259,7 @@ def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12
     rows = np.concatenate([ri, nq + ri])
 
     def full(z):
-        q = q_ref.copy()
-        q[ri] += z[:n]
-        qd = np.zeros(nq)
-        qd[ri] = z[n:]
-        g, gd = dict(zip(coords, q)), dict(zip(coords, qd))
-        qd[k3] = values["H"] / values["C"] - _spin_free_rate(values, g, gd)
-        return np.concatenate([q, qd])
+        return S.state(z[:n], z[n:])
 
     def full_jacobian(z):
         """d full / dz: the identity on z's entries, and gamma3's rate from the integral, an
@@ -315,6 +333,84 @@ def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12
     return X_nl, X_lin, {"newton_steps": steps, "residual": resid, "frequency": w, "period": T,
                          "motion": lambda tt: sol.sol(tt)[:ny], "q_ref": q_ref, "continued_from": climbed,
                          "continuation": {"z": z, "a": a}}
+
+
+def harmonic_balance(model: Model, values: dict, harmonic, samples: int = 32, tol: float = 1e-10,
+                     max_newton: int = 20):
+    """The steady (periodic) response of the full 11-coordinate equations to one harmonic, as
+    `nonlinear_response` finds it by shooting, here by harmonic balance: the reduced
+    coordinates as Fourier series in w t (w = k omega_c; harmonics 0 .. samples/2 - 1), the
+    equations' residual r = x'' - a(x, x', t) (a the emitted equations' accelerations,
+    `gyro.ode`, gamma3's rate from its integral) at `samples` times of the period, turned
+    into the harmonics' residuals R_h, solved for R = 0 by Newton's method on the real and
+    imaginary parts of the coefficients, each scaled by the linear response of its
+    coordinate; the Jacobian is the linear operator's, J(i h w) / M per harmonic, plus the
+    nonlinear terms' by forward differences once per step.
+    Returns (X_nonlinear, X_linear, info) as `nonlinear_response` does, info `newton_steps`,
+    `residual` (the largest |R_h| over the largest |w^2 X_lin|) and `first_correction`
+    (the relative size, in the metric of `linear_error`, of the first Newton step from the
+    linear response: an estimate of the linear level's error). Newton that does not reach
+    tol is RuntimeError, never an unconverged answer (`nonlinear_response` is the
+    reference)."""
+    import casadi as ca
+
+    from gyro import ode
+
+    S = _Periodic(model, values, harmonic)
+    s, k, a, phi = harmonic
+    w, n, N = S.w, S.n, int(samples)
+    H = N // 2 - 1  # harmonics 0..H: below the Nyquist one
+    rhs = ode.rhs(model).map(N)
+    t = np.arange(N) * S.T / N
+    Fin = np.zeros((3, N))
+    Fin[s - 1] = a * np.sin(w * t + phi)
+    h = np.arange(H + 1)
+    E = np.exp(1j * np.outer(t, h * w))  # (N, H+1)
+    units = [model.meta["coordinate_units"][c] for c in model.meta["reduced"]]
+    # per coordinate the scale of its unit group's linear response (as linear_error's metric)
+    group = np.array([max(np.abs(S.X_lin)[[i for i, u in enumerate(units) if u == units[j]]]) for j in range(n)])
+
+    def unpack(z):  # z: scaled (Re C_0, Re C_h, Im C_h for h >= 1) per coordinate
+        Z = z.reshape(2 * H + 1, n) * group
+        C = np.zeros((H + 1, n), complex)
+        C[0] = Z[0]
+        C[1:] = Z[1:H + 1] + 1j * Z[H + 1:]
+        return C
+
+    def residual(z):
+        C = unpack(z)
+        x = (E @ C).real
+        xd = (E @ (C * (1j * h * w)[:, None])).real
+        xdd = (E @ (C * -((h * w) ** 2)[:, None])).real
+        Y = np.stack([S.state(x[j], xd[j]) for j in range(N)], axis=1)
+        acc = np.asarray(rhs(Y, ca.DM(S.P), Fin, np.zeros((3, N))))[S.nq + S.ri].T
+        R = (E.conj().T @ (xdd - acc)) / N * np.where(h == 0, 1.0, 2.0)[:, None]  # x = Re sum C_h e^{i h w t}
+        R = R / (w**2 * group)
+        return np.concatenate([R[0].real, R[1:].real.ravel(), R[1:].imag.ravel()])
+
+    z = np.zeros((2 * H + 1, n))
+    z[1] = S.X_lin.real / group
+    z[H + 1] = S.X_lin.imag / group
+    z = z.ravel()
+    r = residual(z)
+    steps, first = 0, None
+    while np.max(np.abs(r)) > tol:
+        steps += 1
+        if steps > max_newton or not np.all(np.isfinite(r)):
+            raise RuntimeError(f"harmonic balance: no convergence in {max_newton} Newton steps "
+                               f"(residual {np.max(np.abs(r)):.2g})")
+        Jm = np.empty((r.size, z.size))
+        for j in range(z.size):  # forward differences of the scaled residual
+            e = np.zeros(z.size)
+            e[j] = 1e-7
+            Jm[:, j] = (residual(z + e) - r) / 1e-7
+        dz = np.linalg.solve(Jm, -r)
+        if first is None:
+            first = linear_error(unpack(z + dz)[1], S.X_lin, units)
+        z = z + dz
+        r = residual(z)
+    return unpack(z)[1], S.X_lin, {"newton_steps": steps, "residual": float(np.max(np.abs(r))),
+                                   "first_correction": first, "frequency": w, "period": S.T}
 
 
 def spin_torque(model: Model, values: dict, harmonic, info: dict, samples: int = 256) -> dict:

@@ -88,6 +88,18 @@ def numpy_rhs(model: Model, P, inputs=None):
     return fun
 
 
+def jacobian(model: Model):
+    """The compiled CasADi Function jac(y, p, *inputs) -> (y', dy'/dy) of a model (cached per
+    model): the equations of motion and their Jacobian in the state."""
+    key = _key(model, "jacobian")
+    if key not in _CACHE:
+        import casadi as ca
+
+        s = symbolic(model)
+        _CACHE[key] = ca.Function("jacobian", [s.y, s.p, *s.inputs], [s.ydot, ca.jacobian(s.ydot, s.y)])
+    return _CACHE[key]
+
+
 def variational(model: Model):
     """The compiled CasADi Function var(y, Phi, p, *inputs) -> (y', (dy'/dy) Phi) of a model
     (cached per model): the equations of motion with their variational equations, whose

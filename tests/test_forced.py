@@ -305,4 +305,4 @@ def test_harmonic_balance_is_the_shooting_and_its_first_step_estimates_the_linea
     err = linear_error(Xh, Xl, units)
     assert 3e-3 < err < 6e-3  # a nonlinear effect well above both methods' accuracy
     assert info["first_correction"] == pytest.approx(err, rel=1e-3)
-    assert info["residual"] < 1e-11 and info["newton_steps"] <= 4
+    assert info["residual"] < 1e-10 and info["newton_steps"] <= 3  # Newton with its exact Jacobian

@@ -153,23 +153,50 @@ def linear_limit() -> dict:
 
 
 # ----------------------------------------------------------------------------- nonlinear check
-def _rot(axis: str, a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
-    return {"x": np.array([[1, 0, 0], [0, c, -s], [0, s, c]]),
-            "y": np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
-            "z": np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])}[axis]
+def _rot(axis: str, a, lib=np):
+    c, s = lib.cos(a), lib.sin(a)
+    m = {"x": [[1, 0, 0], [0, c, -s], [0, s, c]], "y": [[c, 0, s], [0, 1, 0], [-s, 0, c]],
+         "z": [[c, -s, 0], [s, c, 0], [0, 0, 1]]}[axis]
+    if lib is np:
+        return np.array(m)
+    import casadi as ca
+
+    return ca.blockcat(m)
 
 
-def _spin_free_rate(values: dict, g: dict, gd: dict) -> float:
+ANGLES = ("alpha", "beta", "gamma", "gamma1", "gamma2")  # the angles the spin-free rate depends on
+
+
+def _spin_free_rate(values: dict, g: dict, gd: dict, lib=np):
     """r2 - gamma3' of (1.6): the rotor's absolute rate on its spin axis without the spin,
-    from the Earth rate (1.3) and the casing rate p (1.5), frames (1.2), (1.6)."""
-    phi = np.radians(values["phi"])
-    u = values["u"] * np.array([0.0, np.cos(phi), np.sin(phi)])
-    S = _rot("z", g["alpha"]) @ _rot("x", g["beta"]) @ _rot("y", g["gamma"])
-    p = (S.T @ (u + gd["alpha"] * np.array([0, 0, 1.0]))
-         + gd["beta"] * np.array([np.cos(g["gamma"]), 0, np.sin(g["gamma"])]) + gd["gamma"] * np.array([0, 1.0, 0]))
-    R = _rot("z", g["gamma1"]) @ _rot("x", g["gamma2"])
-    return float((R.T @ (p + gd["gamma1"] * np.array([0, 0, 1.0])) + gd["gamma2"] * np.array([1.0, 0, 0]))[1])
+    from the Earth rate (1.3) and the casing rate p (1.5), frames (1.2), (1.6); with
+    lib = casadi, the same as an expression of symbols."""
+    phi = values["phi"] * np.pi / 180
+    vec = np.array if lib is np else (lambda v: __import__("casadi").vertcat(*v))
+    u = values["u"] * vec([0.0, lib.cos(phi), lib.sin(phi)])
+    S = _rot("z", g["alpha"], lib) @ _rot("x", g["beta"], lib) @ _rot("y", g["gamma"], lib)
+    p = (S.T @ (u + gd["alpha"] * vec([0, 0, 1.0]))
+         + gd["beta"] * vec([lib.cos(g["gamma"]), 0, lib.sin(g["gamma"])]) + gd["gamma"] * vec([0, 1.0, 0]))
+    R = _rot("z", g["gamma1"], lib) @ _rot("x", g["gamma2"], lib)
+    r = (R.T @ (p + gd["gamma1"] * vec([0, 0, 1.0])) + gd["gamma2"] * vec([1.0, 0, 0]))[1]
+    return float(r) if lib is np else r
+
+
+_RATE_JACOBIAN: dict = {}
+
+
+def _spin_free_rate_jacobian():
+    """A CasADi Function (angles (5), their rates (5), u, phi) -> d(spin-free rate)/d(angles,
+    rates) (1 x 10), ANGLES' order: the derivative gamma3's rate from its integral takes."""
+    if "f" not in _RATE_JACOBIAN:
+        import casadi as ca
+
+        a, ad, u, phi = ca.SX.sym("a", 5), ca.SX.sym("ad", 5), ca.SX.sym("u"), ca.SX.sym("phi")
+        r = _spin_free_rate({"u": u, "phi": phi}, dict(zip(ANGLES, ca.vertsplit(a))),
+                            dict(zip(ANGLES, ca.vertsplit(ad))), ca)
+        _RATE_JACOBIAN["f"] = ca.Function("spin_free_rate_jacobian", [a, ad, u, phi],
+                                          [ca.jacobian(r, ca.vertcat(a, ad))])
+    return _RATE_JACOBIAN["f"]
 
 
 class _Periodic:
@@ -365,7 +392,6 @@ def harmonic_balance(model: Model, values: dict, harmonic, samples: int = 32, to
     Fin = np.zeros((3, N))
     Fin[s - 1] = a * np.sin(w * t + phi)
     h = np.arange(H + 1)
-    E = np.exp(1j * np.outer(t, h * w))  # (N, H+1)
     units = [model.meta["coordinate_units"][c] for c in model.meta["reduced"]]
     # per coordinate the scale of its unit group's linear response (as linear_error's metric)
     group = np.array([max(np.abs(S.X_lin)[[i for i, u in enumerate(units) if u == units[j]]]) for j in range(n)])
@@ -377,38 +403,66 @@ def harmonic_balance(model: Model, values: dict, harmonic, samples: int = 32, to
         C[1:] = Z[1:H + 1] + 1j * Z[H + 1:]
         return C
 
-    def residual(z):
-        C = unpack(z)
-        x = (E @ C).real
-        xd = (E @ (C * (1j * h * w)[:, None])).real
-        xdd = (E @ (C * -((h * w) ** 2)[:, None])).real
+    # the real basis of the scaled unknowns at the samples: x_j = sum_m B[j, m] z_m (per
+    # coordinate, times its group scale), m = Re C_0, Re C_h, Im C_h; its rate and acceleration
+    c, sn = np.cos(np.outer(t, h[1:] * w)), np.sin(np.outer(t, h[1:] * w))
+    hw = h[1:] * w
+    Bx = np.hstack([np.ones((N, 1)), c, -sn])
+    Bv = np.hstack([np.zeros((N, 1)), -hw * sn, -hw * c])
+    Ba = np.hstack([np.zeros((N, 1)), -hw**2 * c, hw**2 * sn])
+    # the projection of r_j onto the harmonics' real and imaginary parts, the residual's scale
+    Proj = np.vstack([np.ones((1, N)) / N, 2 / N * c.T, -2 / N * sn.T])
+    rows = np.concatenate([S.ri, S.nq + S.ri])
+    jac = ode.jacobian(model).map(N)
+
+    def samples_of(z):
+        Z = z.reshape(2 * H + 1, n) * group
+        return Bx @ Z, Bv @ Z, Ba @ Z
+
+    def residual(z, with_jacobian=False):
+        x, xd, xdd = samples_of(z)
         Y = np.stack([S.state(x[j], xd[j]) for j in range(N)], axis=1)
-        acc = np.asarray(rhs(Y, ca.DM(S.P), Fin, np.zeros((3, N))))[S.nq + S.ri].T
-        R = (E.conj().T @ (xdd - acc)) / N * np.where(h == 0, 1.0, 2.0)[:, None]  # x = Re sum C_h e^{i h w t}
-        R = R / (w**2 * group)
-        return np.concatenate([R[0].real, R[1:].real.ravel(), R[1:].imag.ravel()])
+        if not with_jacobian:
+            acc = np.asarray(rhs(Y, ca.DM(S.P), Fin, np.zeros((3, N))))[S.nq + S.ri].T
+            return (Proj @ (xdd - acc) / (w**2 * group)).ravel()
+        yd, Jy = jac(Y, ca.DM(S.P), Fin, np.zeros((3, N)))
+        acc = np.asarray(yd)[S.nq + S.ri].T
+        Jy = np.asarray(Jy).reshape(2 * S.nq, N, 2 * S.nq).transpose(1, 0, 2)  # (N, 22, 22): mapped column blocks
+        # d state / d (x, xd) per sample: the identity on the reduced rows, and gamma3's rate
+        # from the integral, minus the spin-free rate, whose derivative is exact (CasADi)
+        dY = np.zeros((N, 2 * S.nq, 2 * n))
+        dY[:, rows, np.arange(2 * n)] = 1.0
+        ia = [S.coords.index(c) for c in ANGLES]
+        red = [list(S.ri).index(i) for i in ia]
+        dr = np.asarray(_spin_free_rate_jacobian().map(N)(Y[ia], Y[[S.nq + i for i in ia]], S.values["u"],
+                                                          S.values["phi"] * 1.0)).reshape(N, 10)
+        dY[:, S.nq + S.k3, red] = -dr[:, :5]
+        dY[:, S.nq + S.k3, [n + i for i in red]] = -dr[:, 5:]
+        A = np.einsum("jrs,jsk->jrk", Jy[:, S.nq + S.ri, :], dY)  # (N, n, 2n): d acc / d (x, xd)
+        Ax, Av = A[:, :, :n], A[:, :, n:]
+        # d r_(j,i) / d z_(m,i') = (Ba[j,m] delta_ii' - Ax[j,i,i'] Bx[j,m] - Av[j,i,i'] Bv[j,m]) group_i'
+        G = (np.einsum("jm,ik->jimk", Ba, np.eye(n)) - np.einsum("jik,jm->jimk", Ax, Bx)
+             - np.einsum("jik,jm->jimk", Av, Bv)) * group[None, None, None, :]
+        Jm = np.einsum("pj,jimk->pimk", Proj, G) / (w**2 * group)[None, :, None, None]
+        r = (Proj @ (xdd - acc) / (w**2 * group)).ravel()
+        return r, Jm.reshape(r.size, r.size)
 
     z = np.zeros((2 * H + 1, n))
     z[1] = S.X_lin.real / group
     z[H + 1] = S.X_lin.imag / group
     z = z.ravel()
-    r = residual(z)
+    r, Jm = residual(z, True)
     steps, first = 0, None
     while np.max(np.abs(r)) > tol:
         steps += 1
         if steps > max_newton or not np.all(np.isfinite(r)):
             raise RuntimeError(f"harmonic balance: no convergence in {max_newton} Newton steps "
                                f"(residual {np.max(np.abs(r)):.2g})")
-        Jm = np.empty((r.size, z.size))
-        for j in range(z.size):  # forward differences of the scaled residual
-            e = np.zeros(z.size)
-            e[j] = 1e-7
-            Jm[:, j] = (residual(z + e) - r) / 1e-7
         dz = np.linalg.solve(Jm, -r)
         if first is None:
             first = linear_error(unpack(z + dz)[1], S.X_lin, units)
         z = z + dz
-        r = residual(z)
+        r, Jm = residual(z, True)
     return unpack(z)[1], S.X_lin, {"newton_steps": steps, "residual": float(np.max(np.abs(r))),
                                    "first_correction": first, "frequency": w, "period": S.T}
 

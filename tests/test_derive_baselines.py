@@ -53,3 +53,12 @@ def test_the_record_holds_every_seed_model_and_its_ratio():
     assert md["goal_s"] == db.GOAL_MAKE_DERIVE_S
     assert md["goal_met"] == (md["wall_s"] <= md["goal_s"])
     assert set(md["per_model_s"]) == set(db.MODELS)
+
+
+def test_a_baseline_past_its_bound_is_reported_as_not_finished():
+    """A bound shorter than the baseline's start: no ratio, only its lower bound S / t_project,
+    and no agreement claimed."""
+    row = db.bench(["gimbal_precession"], timeout=0.05)["gimbal_precession"]
+    assert row["baseline"]["finished"] is False and row["ratio"] is None and row["agree"] is None
+    assert row["ratio_lower_bound"] == pytest.approx(0.05 / row["project"]["total_s"])
+    assert row["goal_met"] is False

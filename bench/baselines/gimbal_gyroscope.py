@@ -47,7 +47,6 @@ def run(point: dict) -> dict:
     G2 = O.locatenew("G2", l * Cs.z)
     G1.v2pt_theory(O, N, Cs)
     G2.v2pt_theory(O, N, Rt)
-    O.set_vel(Rg, 0)
     ring = me.RigidBody("ring", O, Rg, 0, (me.inertia(Rg, 0, 0, C3), O))
     # the model's moments are about the fixed point O (section 1): the bodies carry them with
     # zero mass, so that no translational energy of the centres is added; the weights P1, P

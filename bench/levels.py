@@ -4,7 +4,8 @@ and the figure of the level the selector picks along a sweep.
 
 `python -m bench.levels` (one core): writes bench/results/levels.json, one error-map
 figure per approximate level (levels_error_<level>.png: measured error against its bound)
-and one scene figure per model (scene_<model>.png). `--quick` for a smaller run.
+and one scene figure per model with a hierarchy (scene_<model>.png, its data in
+scenes.json). `--quick` for a smaller run; `--scenes [MODEL ...]` for the scene figures alone.
 
 Spreads (torsion gyrocompass, each about the paper example): spin H, the bearing
 stiffnesses K0, Kp, K_gamma one at a time 0.1x..10x, latitude 0..89 deg, delta_b from 0
@@ -21,12 +22,14 @@ import argparse  # noqa: E402
 import json  # noqa: E402
 import platform  # noqa: E402
 import time  # noqa: E402
+from dataclasses import dataclass  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
 from gyro import ladder  # noqa: E402
 from gyro import levels as hierarchy  # noqa: E402
+from gyro import questions  # noqa: E402
 from gyro.analyses.scene import level_error, select  # noqa: E402
 from gyro.models import load  # noqa: E402
 from gyro.questions import frequencies as F  # noqa: E402
@@ -257,53 +260,189 @@ def error_figures(samples: dict) -> list:
     return files
 
 
-def scene_figure(points: int) -> dict:
-    """Torsion gyrocompass along spin H 0.1x..10x: each level's largest error over the ten
-    modes (lines; its bound dashed), and the level the selector picks for 1e-2, 1e-5, 1e-9."""
+@dataclass
+class Sweep:
+    """One scene figure: a question of a model along a sweep of one physical input. `groups`
+    are the batches the sweep runs in, (P (sets, parameters), the question's options) each:
+    one batch for a parameter sweep, one per point for a sweep of an initial condition (the
+    options hold the initial conditions). `shown`: the levels whose error is drawn, each
+    (level, the level it is measured against or None for the reference itself (its bound
+    alone), every how many points)."""
+
+    model: str
+    question: str
+    x: np.ndarray
+    xlabel: str
+    title: str
+    groups: list
+    shown: tuple
+    logx: bool = True
+
+
+def scene_sweeps(quick: bool) -> list:
+    """The swept inputs of the scene figures, one per model with a hierarchy of levels."""
+    from gyro.analyses.gimbal import stationary_motion
+
+    points = 25 if quick else 61
+    P, s = spreads(points)["spin 0.1x..10x"]
+    out = [Sweep("torsion_gyrocompass", "frequencies", s, "spin H / H of the paper example",
+                 "torsion_gyrocompass: which level the selector picks, against spin\n"
+                 "(H 0.1x..10x the paper example; all ten frequencies)", [(P, {})],
+                 (("formulas", "linear_exact:default", 1), ("linear_paper", "linear_exact:default", 1),
+                  ("linear_exact:companion", "linear_exact:default", 1),
+                  ("linear_exact:default", "linear_exact:reference", 4)))]
+    # the gimbal gyroscope kicked off its unstable stationary motion theta0 = 0.3 rad, H = 0.05
+    # (docs/gimbal.md): the smaller the kick theta'(0), the nearer the separatrix
+    gm = load("gimbal_gyroscope")
+    st = stationary_motion(dict(zip(gm.param_names, gm.vector())), 0.3, 0.05)
+    kicks = np.geomspace(1e-1, 1e-9, 9 if quick else 17)  # one a decade (two)
+    groups = [(gm.vector()[None, :], {"horizon": 30.0, "initial": {"theta0": st.theta0, "dtheta0": float(k),
+                                                                    "dpsi0": st.dpsi0, "dphi0": st.dphi0}})
+              for k in kicks]
+    out.append(Sweep("gimbal_gyroscope", "motion", kicks, "kick theta'(0), rad/s (off the unstable stationary "
+                     "motion theta0 = 0.3 rad, H = 0.05)",
+                     "gimbal_gyroscope: which level the selector picks, toward the separatrix\n"
+                     "(motion psi, theta, phi over 30 s; errors against the closed form)", groups,
+                     (("closed_form", None, 1), ("integrated:DOP853", "closed_form", 1),
+                      ("integrated:Radau", "closed_form", 1))))
+    ghc = load("gyrohorizoncompass")
+    s = np.geomspace(0.1, 10.0, points)
+    P = np.tile(ghc.vector(), (points, 1))
+    P[:, ghc.param_names.index("zeta")] *= s
+    out.append(Sweep("gyrohorizoncompass", "frequencies", s, "zeta = v/R / its default (the ship's speed)",
+                     "gyrohorizoncompass: which level the selector picks, against the speed\n"
+                     "(zeta 0.1x..10x the default; all four frequencies; errors against the 40-digit reference)",
+                     [(P, {})],
+                     (("linear_exact:default", "linear_exact:reference", 1),
+                      ("linear_exact:companion", "linear_exact:reference", 1),
+                      ("linear_exact:polyroots", "linear_exact:reference", 1))))
+    # the precession theories (Ishlinsky) as the outer ring's imbalance grows: (2) of (29) fails
+    gp = load("gimbal_precession")
+    k = np.geomspace(1e-8, 1e-3, 6 if quick else 11)
+    P = np.tile(gp.vector(), (len(k), 1))
+    P[:, gp.param_names.index("k_xi1")] = k
+    out.append(Sweep("gimbal_precession", "motion", k, "outer ring imbalance k_xi1, N m (l_x = 1e-3 N m, H = 1 N m s)",
+                     "gimbal_precession: which theory the selector picks, as the outer ring's imbalance grows\n"
+                     "(the spin axis' image point over 10 s; errors against the full level)", [(P, {"horizon": 10.0})],
+                     (("elementary", "full", 1), ("small", "full", 1), ("rigorous", "full", 1),
+                      ("image", "full", 1), ("full", None, 1))))
+    return out
+
+
+def scene_data(sw: Sweep) -> dict:
+    """What a scene figure draws, measured: per point the level `select` picks at each of
+    TOLS ('' where no level meets it) with its bound, and each shown level's largest error
+    over the quantities against its reference level, with its declared bound."""
+    model = load(sw.model)
+    picked, bound_of_pick, errors = {}, {}, {}
+    for tol in TOLS:
+        lv, bd = [], []
+        for P, opts in sw.groups:
+            sc = select(model, sw.question, P, tol, opts)
+            lv += [str(x) for x in sc.level]
+            bd += [float(b) if np.isfinite(b) else None for b in np.max(sc.bound, axis=1)]
+        picked[str(tol)], bound_of_pick[str(tol)] = lv, bd
+    sizes = np.cumsum([0] + [len(P) for P, _ in sw.groups])
+    for name, against, every in sw.shown:
+        keep = np.arange(len(sw.x))[::every]
+        err, bd = [], []
+        for g, (P, opts) in enumerate(sw.groups):
+            rows = keep[(keep >= sizes[g]) & (keep < sizes[g + 1])] - sizes[g]
+            if rows.size == 0:
+                continue
+            if against is None:
+                B = hierarchy.bounds(model, hierarchy.get(model, name), sw.question, P[rows],
+                                     len(questions.get(sw.question).quantities(model, opts)))
+                ans = questions.get(sw.question).answer(model, hierarchy.get(model, name), P[rows], opts)
+                b, e = B.total(ans.estimate), np.full(len(rows), np.nan)
+            else:
+                e_, b = level_error(model, sw.question, name, against, P[rows], opts)
+                with np.errstate(all="ignore"):  # NaN where a quantity has no relative error (a zero root)
+                    e = np.array([np.nanmax(r) if np.isfinite(r).any() else np.nan for r in e_])
+            err += [float(x) if np.isfinite(x) else None for x in e]
+            bd += [float(x) if np.isfinite(x) else None for x in np.max(b, axis=1)]
+        errors[name] = {"against": against, "x": [float(v) for v in sw.x[keep]], "error": err, "bound": bd}
+    return {"question": sw.question, "xlabel": sw.xlabel, "x": [float(v) for v in sw.x],
+            "options": [o for _, o in sw.groups],
+            "picked": picked, "bound_of_pick": bound_of_pick, "errors": errors}
+
+
+def scene_figure(sw: Sweep, data: dict) -> str:
+    """One model's scene figure from its measured data: above, each shown level's largest
+    error over the quantities (line; its bound dashed) and the three tolerances; below, the
+    level the selector picks at each point for each tolerance, a cross on the row 'no level
+    meets it' where none does (gyro scene exits 1 there)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    P, s = spreads(points)["spin 0.1x..10x"]
-    shown = ("formulas", "linear_paper", "linear_exact:companion", "linear_exact:default")
-    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(7, 6.5), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
-    for i, name in enumerate(shown):
-        against = "linear_exact:reference" if name == "linear_exact:default" else "linear_exact:default"
-        Pk = P[::4] if against.endswith("reference") else P
-        sk = s[::4] if against.endswith("reference") else s
-        err, bound = level_error(TG, "frequencies", name, against, Pk)
-        ax.loglog(sk, np.nanmax(err, axis=1), "-", color=f"C{i}", label=f"{name}: error")
-        ax.loglog(sk, np.max(bound, axis=1), "--", color=f"C{i}", lw=1, label=f"{name}: bound")
+    model = load(sw.model)
+    x = np.asarray(data["x"])
+    fig, (ax, ax2) = plt.subplots(2, 1, figsize=(10, 6.5), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
+    nan = lambda v: np.array([np.nan if y is None else y for y in v], dtype=float)  # noqa: E731
+    for i, (name, against, _) in enumerate(sw.shown):
+        d = data["errors"][name]
+        xs = np.asarray(d["x"])
+        if against is not None:
+            ax.plot(xs, nan(d["error"]), "-", color=f"C{i}", marker="." if len(xs) < 15 else None,
+                    label=f"{name}: error against {against}")
+        ax.plot(xs, nan(d["bound"]), "--", color=f"C{i}", lw=1,
+                label=f"{name}: bound" + (" (the reference)" if against is None else ""))
     for tol in TOLS:
         ax.axhline(tol, color="0.6", lw=0.8)
-        ax.text(s[0], tol * 1.3, f"tol {tol:g}", fontsize=7, color="0.4")
-    ax.set_ylabel("largest relative error over the 10 modes")
-    ax.set_ylim(1e-17, 10)
-    ax.legend(fontsize=7, ncol=2, loc="lower right")
-    ax.set_title("torsion_gyrocompass: which level the selector picks, against spin\n"
-                 "(H 0.1x..10x the paper example; all ten frequencies)", fontsize=9)
-    order = [lv.name for lv in hierarchy.levels(TG) if lv.answers_question("frequencies")]
-    picks = {}
+        ax.text(x.min(), tol * 1.3, f"tol {tol:g}", fontsize=7, color="0.4")
+    drawn = [v for d in data["errors"].values() for v in d["error"] + d["bound"] if v]
+    ax.set_yscale("log")
+    ax.set_ylabel("largest relative error over the quantities")
+    ax.set_ylim(max(1e-17, min(drawn + [min(TOLS)]) / 30), 10)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    ax.set_title(sw.title, fontsize=9)
+    order = [lv.name for lv in hierarchy.levels(model) if lv.answers_question(sw.question)]
+    rows = ["no level meets it", *order]
     for j, tol in enumerate(TOLS):
-        sc = select(TG, "frequencies", P, tol)
-        picks[str(tol)] = [str(x) for x in sc.level]
-        y = [order.index(x) for x in sc.level]
-        ax2.plot(s, y, "o-", ms=3, lw=1, label=f"tol {tol:g}", color=f"C{j + 4}")
-    ax2.set_yticks(range(len(order)), order, fontsize=7)
-    ax2.set_xscale("log")
-    ax2.set_xlabel("spin H / H of the paper example")
-    ax2.legend(fontsize=7, loc="upper left")
+        y = np.array([rows.index(v or "no level meets it") for v in data["picked"][str(tol)]])
+        ax2.plot(x, y + (j - 1) * 0.08, "-", lw=1, color=f"C{j + 4}", label=f"tol {tol:g}")
+        none = y == 0
+        ax2.plot(x[~none], y[~none] + (j - 1) * 0.08, "o", ms=3, color=f"C{j + 4}")
+        ax2.plot(x[none], y[none] + (j - 1) * 0.08, "x", ms=6, mew=1.5, color=f"C{j + 4}")
+    ax2.set_yticks(range(len(rows)), rows, fontsize=7)
+    ax2.set_ylim(-0.5, len(rows) - 0.5)
+    if sw.logx:
+        ax.set_xscale("log")
+    ax2.set_xlabel(sw.xlabel)
+    ax2.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
-    fig.savefig(RESULTS / "scene_torsion_gyrocompass.png", dpi=110)
+    name = f"scene_{sw.model}.png"
+    fig.savefig(RESULTS / name, dpi=110)
     plt.close(fig)
-    return {"x": "H / H_example", "values": [float(x) for x in s], "picked": picks}
+    return name
+
+
+def scenes(quick: bool, only: list | None = None) -> dict:
+    """Every scene figure and its data (bench/results/scenes.json)."""
+    path = RESULTS / "scenes.json"
+    out = json.loads(path.read_text()) if path.exists() and only else {}
+    for sw in scene_sweeps(quick):
+        if only and sw.model not in only:
+            continue
+        t0 = time.perf_counter()
+        out[sw.model] = scene_data(sw) | {"quick": quick}
+        out[sw.model]["figure"] = scene_figure(sw, out[sw.model])
+        print(f"scene {sw.model}: {time.perf_counter() - t0:.0f} s", flush=True)
+    path.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
+    return out
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--scenes", nargs="*", metavar="MODEL",
+                    help="only the scene figures (of these models; all without a name): scenes.json")
     args = ap.parse_args(argv)
+    if args.scenes is not None:
+        scenes(args.quick, args.scenes or None)
+        return 0
     out = {"machine": {"python": platform.python_version(), "processor": platform.machine(),
                        "cores": os.cpu_count()}, "quick": args.quick}
     t0 = time.perf_counter()
@@ -314,7 +453,7 @@ def main(argv=None) -> int:
     out["gimbal_error_map"] = gimbal_map(args.quick)
     print(f"error maps: {time.perf_counter() - t0:.0f} s", flush=True)
     out["figures"] = error_figures(samples)
-    out["scene_sweep"] = scene_figure(25 if args.quick else 61)
+    scenes(args.quick)
     print(f"figures: {time.perf_counter() - t0:.0f} s", flush=True)
     out["speed"] = speed(args.quick)
     print(f"speed: {time.perf_counter() - t0:.0f} s", flush=True)

@@ -125,9 +125,11 @@ def _steps(level: str, n: int) -> int:
 def _check_grid(t: np.ndarray):
     """(grid, where) of the check: the asked times t / T with CHECK_POINTS evenly spaced ones
     among them (a motion that passes +-90 deg and returns between two asked times is seen
-    there), and where the asked times are in it; None where t is as dense already."""
+    there), and where the asked times are in it; None where no gap between asked times is
+    wider than the check's (decided by the widest gap, not by how many times are asked:
+    the times may be uneven)."""
     asked = t / float(t[-1])
-    if len(t) >= CHECK_POINTS:
+    if np.max(np.diff(asked)) <= 1.0 / (CHECK_POINTS - 1):  # as dense as the check already, everywhere
         return None
     grid = np.union1d(asked, np.linspace(0.0, 1.0, CHECK_POINTS))
     return tuple(float(g) for g in grid), np.searchsorted(grid, asked)
@@ -192,7 +194,9 @@ def oscillating_base(values: dict, terms) -> OscillatingBase:
 # CasADi operations that make a function of t jump (a step, a comparison, a branch, a
 # sawtooth): their derivative is taken as 0, so the impulse u' of a jump would be lost
 _JUMPS = ("OP_LT", "OP_LE", "OP_EQ", "OP_NE", "OP_NOT", "OP_AND", "OP_OR", "OP_IF_ELSE_ZERO", "OP_FLOOR",
-          "OP_CEIL", "OP_FMOD", "OP_REMAINDER", "OP_SIGN", "OP_COPYSIGN")
+          "OP_CEIL", "OP_FMOD", "OP_REMAINDER", "OP_SIGN", "OP_COPYSIGN",
+          "OP_ATAN2",  # its branch cut: atan2(sin t, cos t) is a sawtooth
+          "OP_LOW", "OP_CALL")  # a table lookup, a call of another function: not seen into
 
 
 def _base_signals(base):
@@ -227,7 +231,8 @@ def _base_signals(base):
     values = ca.Function("base_value", [t], u)
     jumps = {getattr(ca, name) for name in _JUMPS if hasattr(ca, name)}
     if any(values.instruction_id(k) in jumps for k in range(values.n_instructions())):
-        raise ParameterError("base: the base rate jumps (a step, comparison, branch, floor, mod or sign of t): "
+        raise ParameterError("base: the base rate may jump (a step, comparison, branch, floor, mod, sign or "
+                             "atan2 of t, or a lookup or call): "
                              "its derivative, an impulse, would be lost; write it as a smooth function of t")
     return t, col, fun, fun.serialize()
 

@@ -305,3 +305,52 @@ def test_harmonic_balance_is_the_shooting_and_its_first_step_estimates_the_linea
     assert 3e-3 < err < 6e-3  # a nonlinear effect well above both methods' accuracy
     assert info["first_correction"] == pytest.approx(err, rel=1e-3)
     assert info["residual"] < 1e-10 and info["newton_steps"] <= 3  # Newton with its exact Jacobian
+
+
+# --------------------------------------------------------------------------- the forced question
+
+
+def test_the_forced_question_takes_the_linear_level_while_its_estimate_allows():
+    """`gyro scene ... forced`: the linear level answers while twice harmonic balance's first
+    step stays within the tolerance, the nonlinear level (harmonic balance) above; its
+    actual error against the nonlinear level is within the bound it gave, per coordinate,
+    away from and near the radial resonance, up to and past the 1 % limits."""
+    from gyro.analyses.forced import cases
+    from gyro.analyses.scene import level_error, select
+
+    for case, amps in (("away", (100.0, 2400.0)), ("near", (4.0, 32.0))):
+        values, (s, k, phi) = cases(MODEL)[case]
+        P = MODEL.vector(values)
+        for a in amps:
+            opts = {"harmonic": (s, k, a, phi)}
+            err, bound = level_error(MODEL, "forced", "linear", "nonlinear", P, opts)
+            assert np.all(err <= bound), (case, a, err, bound)
+            assert np.nanmax(err) > 0.2 * np.nanmax(bound)  # and not loose: the bound is twice the step
+    values, (s, k, phi) = cases(MODEL)["away"]
+    P = MODEL.vector(values)
+    small = select(MODEL, "forced", P, 1e-3, {"harmonic": (s, k, 100.0, phi)})
+    assert small.level[0] == "linear"
+    large = select(MODEL, "forced", P, 1e-3, {"harmonic": (s, k, 2400.0, phi)})
+    assert large.level[0] == "nonlinear" and [t.level for t in large.trials] == ["linear", "nonlinear"]
+    tight = select(MODEL, "forced", P, 1e-9, {"harmonic": (s, k, 100.0, phi)})
+    assert tight.level[0] == "" and tight.best(0)[1] == "nonlinear"
+
+
+def test_the_forced_question_at_the_command_line():
+    code, out, err = run_cli("scene", "torsion_gyrocompass", "forced", "--harmonic", "1:1:100", "--tol", "1e-3", "--json")
+    assert code == 0, err
+    d = json.loads(out)
+    assert d["level"] == "linear" and d["question"] == "forced"
+    assert d["coordinates"] == ["x1", "x3", "gamma", "mu", "x2", "gamma1", "gamma2", "alpha", "beta", "lam"]
+    assert len(d["amplitudes"]) == len(d["phases"]) == len(d["error_bound"]) == 10
+    assert max(d["error_bound"]) <= 1e-3 and d["frequency"] > 0
+    # the linear level's amplitudes are gyro forced's
+    code, out2, _ = run_cli("forced", "torsion_gyrocompass", "--harmonic", "1:1:100", "--json")
+    assert np.allclose(json.loads(out2)["harmonics"][0]["amplitudes"], d["amplitudes"], rtol=1e-12, atol=0)
+    for args, name in [((), "--harmonic"), (("--harmonic", "4:1:1"), "--harmonic")]:
+        code, out, err = run_cli("scene", "torsion_gyrocompass", "forced", "--tol", "1e-3", *args)
+        assert code == 2 and out == "" and name in err and len(err.strip().splitlines()) == 1
+    code, out, err = run_cli("scene", "torsion_gyrocompass", "frequencies", "--tol", "1e-3", "--harmonic", "1:1:1")
+    assert code == 2 and "--harmonic" in err
+    code, out, err = run_cli("scene", "torsion_gyrocompass", "forced", "--harmonic", "1:1:100", "--tol", "1e-9")
+    assert code == 1 and "best bound" in err

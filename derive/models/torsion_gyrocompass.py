@@ -554,6 +554,16 @@ def levels(F):
               valid={"l2 != 0 (the sag's bound)": sp.Abs(l2)},
               cost=2.0e-5, reference="linear_exact",
               doc="the paper's printed operator (2.4), corrected: roots of its blocks' characteristic polynomials"),
+        Level("linear", "the full equations' terms of second and higher order in the amplitudes",
+              # costs: medians over the bench's two ladders of amplitudes (bench/forced_nonlinear.py,
+              # first_step_seconds and harmonic_balance.seconds in bench/results/forced_linear_limit.json)
+              {"kind": "harmonic"}, {"forced": Bound(estimate=True)}, cost=1.5e-2, reference="nonlinear",
+              doc="the linear response J(i w) X = B u to one imperfection harmonic, its error estimated by "
+                  "harmonic balance's first Newton step (docs/forced.md)"),
+        Level("nonlinear", "harmonics of the forcing above the 15th in the periodic response",
+              {"kind": "harmonic_balance"}, {"forced": Bound(estimate=True)}, cost=4.2e-2,
+              doc="the periodic response of the full 11-coordinate equations by harmonic balance, checked "
+                  "against the shooting (docs/forced.md)"),
         Level("linear_exact", exact,
               {"kind": "spectrum", "methods": ["polyroots", "companion", "default", "reference"], "default": "default"},
               {"frequencies": Bound(estimate=True), "stability": Bound(estimate=True)},

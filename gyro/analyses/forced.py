@@ -371,7 +371,7 @@ def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12
 
 
 def harmonic_balance(model: Model, values: dict, harmonic, samples: int = 32, tol: float = 1e-10,
-                     max_newton: int = 20):
+                     max_newton: int = 20, first_step_only: bool = False):
     """The steady (periodic) response of the full 11-coordinate equations to one harmonic, as
     `nonlinear_response` finds it by shooting, here by harmonic balance: the reduced
     coordinates as Fourier series in w t (w = k omega_c; harmonics 0 .. samples/2 - 1), the
@@ -386,7 +386,9 @@ def harmonic_balance(model: Model, values: dict, harmonic, samples: int = 32, to
     (the relative size, in the metric of `linear_error`, of the first Newton step from the
     linear response: an estimate of the linear level's error). Newton that does not reach
     tol is RuntimeError, never an unconverged answer (`nonlinear_response` is the
-    reference)."""
+    reference). With `first_step_only`, the answer after the first Newton step alone (info
+    `converged` False unless the linear response already met tol): the linear level's
+    error estimate, not the nonlinear response."""
     import casadi as ca
 
     from gyro import ode
@@ -470,9 +472,13 @@ def harmonic_balance(model: Model, values: dict, harmonic, samples: int = 32, to
         if first is None:
             first = linear_error(unpack(z + dz)[1], S.X_lin, units)
         z = z + dz
+        if first_step_only:
+            return unpack(z)[1], S.X_lin, {"newton_steps": steps, "first_correction": first, "converged": False,
+                                           "frequency": w, "period": S.T, "group": group}
         r, Jm = residual(z, True)
     return unpack(z)[1], S.X_lin, {"newton_steps": steps, "residual": float(np.max(np.abs(r))),
-                                   "first_correction": first, "frequency": w, "period": S.T}
+                                   "first_correction": 0.0 if first is None else first, "converged": True,
+                                   "frequency": w, "period": S.T, "group": group}
 
 
 def spin_torque(model: Model, values: dict, harmonic, info: dict, samples: int = 256) -> dict:

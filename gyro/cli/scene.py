@@ -1,4 +1,5 @@
-"""`gyro scene MODEL QUESTION --tol REL [--set NAME=VALUE]... [--modes I,J,...] [--horizon T] [--json]`
+"""`gyro scene MODEL QUESTION --tol REL [--set NAME=VALUE]... [--modes I,J,...] [--horizon T]
+[--harmonic S:K:AMP[:PHASE]] [--json]`
 
 The question answered within the relative tolerance REL by the cheapest level of the
 model's hierarchy whose bound meets it (docs/hierarchy.md)."""
@@ -25,6 +26,8 @@ def register(sub) -> None:
     f.add_argument("--modes", metavar="I,J,...", help="frequencies: only these modes (1 = the slowest)")
     f.add_argument("--horizon", metavar="T", help="motion: the time span in s")
     f.add_argument("--t-end", dest="horizon", metavar="T", help="motion: the same as --horizon")
+    f.add_argument("--harmonic", metavar="S:K:AMP[:PHASE]",
+                   help="forced: the imperfection harmonic f_S = AMP sin(K omega_c t + PHASE), as gyro forced takes it")
     add_json(f)
     f.set_defaults(run=run)
 
@@ -74,6 +77,14 @@ def run(args) -> int:
         opts["horizon"] = finite_number("--horizon", args.horizon)
         if not opts["horizon"] > 0:
             raise ParameterError(f"--horizon: must be positive, got {args.horizon!r}")
+    if args.harmonic is not None:
+        if args.question != "forced":
+            raise ParameterError(f"--harmonic: only for the forced question, not {args.question!r}")
+        from gyro.analyses.forced import parse_harmonic
+
+        opts["harmonic"] = parse_harmonic(args.harmonic)
+    elif args.question == "forced":
+        raise ParameterError("--harmonic: the forced question needs one harmonic S:K:AMP[:PHASE]")
     scene = select(model, args.question, model.vector(values), tol, opts)
     if not scene.answered[0]:
         b, lv = scene.best(0)

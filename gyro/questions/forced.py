@@ -1,0 +1,95 @@
+"""`forced`: the steady response of every coordinate to one harmonic of the bearing
+imperfections, f_s = a sin(k omega_c t + phi) (`--harmonic S:K:AMP[:PHASE]`, as `gyro
+forced` takes it); one quantity per reduced coordinate (the model's order), its complex
+amplitude X (x = Re(X e^{i k omega_c t}) about the equilibrium). The relative error of a
+quantity is |X - X_ref| over the largest linear amplitude of its unit group (translations,
+angles), the metric of `gyro.analyses.forced.linear_error` per coordinate: a coordinate whose
+response is a millionth of its group's is not asked for six digits of its own.
+
+Evaluator kinds (gyro.analyses.forced):
+- `harmonic`: the linear response J(i w) X = B u; its own estimate is twice the first Newton
+  step of harmonic balance from it, per coordinate (measured: that step is the linear
+  response's error to 3.6e-4 of itself up to the 1 % limits; docs/forced.md);
+- `harmonic_balance`: the periodic response of the full 11-coordinate equations by harmonic
+  balance; its own estimate is `ESTIMATE_NONLINEAR` (measured: it agrees with the shooting
+  to 4.4e-9 of the response on every rung of the bench's ladders).
+A set whose evaluator fails (a resonance: the linear amplitude infinite; harmonic balance
+not converging) fails with its reason, and the selector goes up. JSON keys: `frequency`
+(k omega_c, rad/s), `coordinates`, `amplitudes` (peak, SI units), `phases` (rad, in the
+form of the forcing: x = amplitude sin(w t + phase)).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from gyro.errors import ParameterError
+from gyro.questions import Answer, unknown_kind
+
+NAME = "forced"
+SAFETY = 2.0  # the linear level's estimate: this many times harmonic balance's first step
+ESTIMATE_NONLINEAR = 1e-8  # harmonic balance against the shooting: 4.4e-9 at most, measured
+
+
+def quantities(model, opts) -> list[str]:
+    return list(model.meta["reduced"])
+
+
+def requested(model, opts) -> list[int]:
+    return list(range(len(quantities(model, opts))))
+
+
+def harmonic(opts):
+    h = opts.get("harmonic")
+    if h is None:
+        raise ParameterError("--harmonic: the forced question needs one harmonic S:K:AMP[:PHASE]")
+    return h
+
+
+def answer(model, level, P, opts) -> Answer:
+    from gyro.analyses import forced
+
+    kind = level.evaluator.get("kind")
+    if kind not in ("harmonic", "harmonic_balance"):
+        raise unknown_kind(NAME, level)
+    s, k, a, phi = harmonic(opts)
+    N, n = P.shape[0], len(quantities(model, opts))
+    X = np.full((N, n), np.nan, complex)
+    est = np.full((N, n), np.inf)
+    scale = np.full((N, n), np.nan)
+    failed = np.full(N, "", object)
+    freq = np.full(N, np.nan)
+    for j in range(N):
+        values = dict(zip(model.param_names, map(float, P[j])))
+        try:
+            if kind == "harmonic":
+                X1, Xl, info = forced.harmonic_balance(model, values, (s, k, a, phi), first_step_only=True)
+                X[j] = Xl
+                est[j] = SAFETY * np.abs(X1 - Xl) / info["group"] + 1e-15
+            else:
+                Xn, Xl, info = forced.harmonic_balance(model, values, (s, k, a, phi))
+                X[j] = Xn
+                est[j] = ESTIMATE_NONLINEAR
+        except (ArithmeticError, ValueError, RuntimeError, np.linalg.LinAlgError) as exc:
+            failed[j] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            continue
+        scale[j] = info["group"]
+        freq[j] = info["frequency"]
+        if not (np.all(np.isfinite(Xl)) and np.all(np.isfinite(X[j]))):
+            failed[j] = "a resonance: the linear response is unbounded"
+    return Answer(np.abs(X), est, failed, {"X": X, "scale": scale, "frequency": freq})
+
+
+def edges(model, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
+    return np.full(ans.values.shape[0], "", object)
+
+
+def error(ans: Answer, ref: Answer) -> np.ndarray:
+    with np.errstate(all="ignore"):
+        return np.abs(ans.extra["X"] - ref.extra["X"]) / ref.extra["scale"]
+
+
+def document(model, ans: Answer, k: int, idx) -> dict:
+    X = ans.extra["X"][k]
+    return {"frequency": float(ans.extra["frequency"][k]), "coordinates": quantities(model, {}),
+            "amplitudes": [float(v) for v in np.abs(X)],
+            "phases": [float(v) for v in np.angle(1j * X)]}

@@ -282,6 +282,15 @@ def test_the_spin_torque_left_out_is_measured():
     k3 = coords.index("gamma3")
     by_hand = (g["x1"] + MODEL.defaults["h"] * g["gamma1"]) * f1d
     assert full[k3] - none[k3] == pytest.approx(by_hand, rel=1e-12)
+    # the momentum's swing by another route: the torque by hand along the motion at 2048
+    # times, integrated by the trapezoidal rule, its periodic part (review: restated before)
+    ts = np.linspace(0.0, info["period"], 2049)
+    Ys = info["motion"](ts)
+    gs = dict(zip(coords, Ys[:11]))
+    tau = (gs["x1"] + MODEL.defaults["h"] * gs["gamma1"]) * a * k * np.cos(w * ts + phi)
+    dH = np.concatenate([[0.0], np.cumsum((tau[1:] + tau[:-1]) / 2 * np.diff(ts))])
+    dH -= np.trapezoid(dH, ts) / info["period"]
+    assert np.max(np.abs(dH)) / H == pytest.approx(out["momentum_swing"], rel=1e-3)
 
 
 def test_harmonic_balance_is_the_shooting_and_its_first_step_estimates_the_linear_error():

@@ -19,34 +19,24 @@ from pathlib import Path
 
 import numpy as np
 
+from bench.baselines.common import fresh
+
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"
 
 
-def _fresh(args: list[str], timeout: float | None = None) -> tuple[dict | None, float]:
-    t0 = time.perf_counter()
-    try:
-        out = subprocess.run([sys.executable, *args], cwd=ROOT, capture_output=True, text=True,
-                             timeout=timeout, check=True)
-    except subprocess.TimeoutExpired:
-        return None, time.perf_counter() - t0
-    wall = time.perf_counter() - t0
-    lines = [ln for ln in out.stdout.strip().splitlines() if ln.startswith("{")]
-    return (json.loads(lines[-1]) if lines else {}), wall
-
-
 def bench_derive(timeout: float, skip_baseline: bool) -> dict:
     print("this project: derivation of J(p) in a fresh process ...", flush=True)
-    ours, _ = _fresh(["-m", "bench.derive_speed"])
+    ours, _ = fresh(["-m", "bench.derive_speed"])
     print(f"  J(p): {ours['derive_J_s']:.2f} s (imports {ours['import_s']:.2f} s)", flush=True)
     print("this project: full `python -m derive` (all steps and emission) ...", flush=True)
-    _, full_wall = _fresh(["-m", "derive", "--out", str(RESULTS / "_derive_tmp")])
+    _, full_wall = fresh(["-m", "derive", "--out", str(RESULTS / "_derive_tmp")])
     print(f"  make derive: {full_wall:.2f} s", flush=True)
     result = {"ours": ours, "ours_make_derive_s": full_wall}
     if skip_baseline:
         return result
     print(f"baseline: sympy.physics.mechanics, bounded by {timeout:.0f} s ...", flush=True)
-    base, wall = _fresh(["bench/baseline_mechanics.py", "--json"], timeout=timeout)
+    base, wall = fresh(["bench/baseline_mechanics.py", "--json"], timeout=timeout)
     if base is None:
         base_time, finished = timeout, False
         print(f"  did not finish within {timeout:.0f} s: {timeout:.0f} s is reported as its time")

@@ -37,6 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
+from bench.baselines.common import fresh
+
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"
 MODELS = ("torsion_gyrocompass", "gimbal_gyroscope", "gyrohorizoncompass", "gimbal_precession")
@@ -212,18 +214,6 @@ def agreement(ours: dict, theirs: dict, order=None, their_order=None) -> dict:
 
 # ----------------------------------------------------------------------------- the bench
 
-def _fresh(args: list[str], timeout: float | None = None) -> tuple[dict | None, float]:
-    t0 = time.perf_counter()
-    try:
-        out = subprocess.run([sys.executable, *args], cwd=ROOT, capture_output=True, text=True,
-                             timeout=timeout, check=True)
-    except subprocess.TimeoutExpired:
-        return None, time.perf_counter() - t0
-    wall = time.perf_counter() - t0
-    lines = [ln for ln in out.stdout.strip().splitlines() if ln.startswith("{")]
-    return (json.loads(lines[-1]) if lines else {}), wall
-
-
 def bench(models, timeout: float, tolerance: float = 1e-10) -> dict:
     from bench.baselines.common import run_child
 
@@ -231,9 +221,9 @@ def bench(models, timeout: float, tolerance: float = 1e-10) -> dict:
     res = {}
     for name in models:
         print(f"{name}: {QUANTITY[name]}", flush=True)
-        ours, ours_wall = _fresh(["-m", "bench.derive_baselines", "--project", name])
+        ours, ours_wall = fresh(["-m", "bench.derive_baselines", "--project", name])
         print(f"  this project: {ours['total_s']:.2f} s (imports {ours['import_s']:.2f} s)", flush=True)
-        whole, whole_wall = _fresh(["-m", "bench.derive_baselines", "--pipeline", name])
+        whole, whole_wall = fresh(["-m", "bench.derive_baselines", "--pipeline", name])
         top = max(whole["steps_s"].items(), key=lambda kv: kv[1])
         print(f"  this project, whole per-model derivation: {whole['total_s']:.2f} s "
               f"(largest step: {top[0]} {top[1]:.2f} s)", flush=True)

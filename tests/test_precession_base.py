@@ -297,13 +297,10 @@ def test_a_base_is_integrated_as_it_is_now_not_as_it_was():
     assert np.array_equal(pr.simulate(v, t, "rigorous", base=r).y, first.y)
     r.amp = 0.0
     assert np.array_equal(pr.simulate(v, t, "rigorous", base=r).y, constant.y)
-    # 0.1 and the next double print alike; the key tells them apart
-    a = pr.simulate(v, t, "rigorous", base=lambda s: (0.1 * np.sin(s), 0.0, 0.0))
+    # 0.1 and the next double print alike; the key, and so the integrator, tells them apart
     up = float(np.nextafter(0.1, 1.0))
-    b = pr.simulate(v, t, "rigorous", base=lambda s: (up * np.sin(s), 0.0, 0.0))
     assert pr._base_signals(lambda s: (0.1 * np.sin(s), 0.0, 0.0))[3] != pr._base_signals(
         lambda s: (up * np.sin(s), 0.0, 0.0))[3]
-    assert not np.array_equal(a.y, b.y) or np.abs(a.y - b.y).max() == 0  # its own run (a difference may round away)
 
 
 @pytest.mark.parametrize("jump", [lambda s: np.heaviside(s - 1, 0.5), lambda s: np.where(s > 1, 1.0, 0.0),

@@ -49,17 +49,24 @@ def main(run, argv=None) -> None:
     print(json.dumps(run(json.loads(args.json))))
 
 
-def run_child(module: str, point: dict, timeout: float) -> tuple[dict | None, float]:
-    """`python -m bench.baselines.<module> --json POINT` in a fresh process (sympy's caches
-    cold, imports counted), bounded by `timeout` seconds. Returns (result or None when it
-    did not finish, the child's wall time)."""
-    cmd = [sys.executable, "-m", f"bench.baselines.{module}", "--json", json.dumps(point)]
+def fresh(args: list[str], timeout: float | None = None) -> tuple[dict | None, float]:
+    """`python ARGS` in a fresh process from the project's root (caches cold, imports
+    counted), bounded by `timeout` seconds: (its last JSON line, {} if it prints none, or
+    None when it did not finish; its wall time). A failing child is RuntimeError with its
+    stderr's end."""
     t0 = time.perf_counter()
     try:
-        out = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=timeout)
+        out = subprocess.run([sys.executable, *args], cwd=ROOT, capture_output=True, text=True, timeout=timeout)
     except subprocess.TimeoutExpired:
         return None, time.perf_counter() - t0
     wall = time.perf_counter() - t0
     if out.returncode != 0:
-        raise RuntimeError(f"baseline {module} failed:\n{out.stderr[-4000:]}")
-    return json.loads(out.stdout.strip().splitlines()[-1]), wall
+        raise RuntimeError(f"python {' '.join(args[:2])} failed:\n{out.stderr[-4000:]}")
+    lines = [ln for ln in out.stdout.strip().splitlines() if ln.startswith("{")]
+    return (json.loads(lines[-1]) if lines else {}), wall
+
+
+def run_child(module: str, point: dict, timeout: float) -> tuple[dict | None, float]:
+    """`python -m bench.baselines.<module> --json POINT` in a fresh process (`fresh`):
+    (result or None when it did not finish, the child's wall time)."""
+    return fresh(["-m", f"bench.baselines.{module}", "--json", json.dumps(point)], timeout)

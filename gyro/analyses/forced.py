@@ -237,6 +237,21 @@ class _Periodic:
         qd[self.k3] = self.values["H"] / self.values["C"] - _spin_free_rate(self.values, g, gd)
         return np.concatenate([q, qd])
 
+    def state_jacobian(self, Y: np.ndarray) -> np.ndarray:
+        """d state / d (x, xd) at full states Y (2 nq, N): (N, 2 nq, 2 n), the identity on the
+        reduced rows, and gamma3's rate from the integral, minus the spin-free rate, whose
+        derivative in the angles and their rates is exact (CasADi, _spin_free_rate_jacobian)."""
+        N, n, nq = Y.shape[1], self.n, self.nq
+        dY = np.zeros((N, 2 * nq, 2 * n))
+        dY[:, np.concatenate([self.ri, nq + self.ri]), np.arange(2 * n)] = 1.0
+        ia = [self.coords.index(c) for c in ANGLES]
+        red = [list(self.ri).index(i) for i in ia]
+        dr = np.asarray(_spin_free_rate_jacobian().map(N)(Y[ia], Y[[nq + i for i in ia]], self.values["u"],
+                                                          self.values["phi"] * 1.0)).reshape(N, 10)
+        dY[:, nq + self.k3, red] = -dr[:, :5]
+        dY[:, nq + self.k3, [n + i for i in red]] = -dr[:, 5:]
+        return dY
+
 
 def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12, max_newton: int = 12,
                        periodic_tol: float | None = None, start: dict | None = None, halvings: int = 6):
@@ -288,22 +303,6 @@ def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12
     def full(z):
         return S.state(z[:n], z[n:])
 
-    ia = [coords.index(c) for c in ANGLES]
-    red = [list(ri).index(i) for i in ia]
-
-    def full_jacobian(z):
-        """d full / dz: the identity on z's entries, and gamma3's rate from the integral,
-        minus the spin-free rate, whose derivative in the angles and their rates is exact
-        (CasADi, _spin_free_rate_jacobian)."""
-        Jf = np.zeros((ny, 2 * n))
-        Jf[rows, np.arange(2 * n)] = 1.0
-        y = full(z)
-        dr = np.asarray(_spin_free_rate_jacobian()(y[ia], y[[nq + i for i in ia]], values["u"],
-                                                   values["phi"] * 1.0)).ravel()
-        Jf[nq + k3, red] = -dr[:5]
-        Jf[nq + k3, [n + i for i in red]] = -dr[5:]
-        return Jf
-
     def period(z):
         Y0 = np.concatenate([full(z), np.eye(ny).ravel(order="F")])
         sol = solve_ivp(fun, (0.0, T), Y0, method="DOP853", rtol=rtol, atol=atol, dense_output=True)
@@ -311,7 +310,7 @@ def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12
             raise RuntimeError(f"integration failed: {sol.message}")
         YT = sol.y[:, -1]
         zT = np.concatenate([YT[ri] - q_ref[ri], YT[nq + ri]])
-        monodromy = YT[ny:].reshape(ny, ny, order="F")[rows] @ full_jacobian(z)
+        monodromy = YT[ny:].reshape(ny, ny, order="F")[rows] @ S.state_jacobian(full(z)[:, None])[0]
         return zT, monodromy, sol
 
     z = np.concatenate([X_lin.real, (1j * w * X_lin).real])
@@ -397,7 +396,6 @@ def harmonic_balance(model: Model, values: dict, harmonic, samples: int = 32, to
     s, k, a, phi = harmonic
     w, n, N = S.w, S.n, int(samples)
     H = N // 2 - 1  # harmonics 0..H: below the Nyquist one
-    rhs = ode.rhs(model).map(N)
     t = np.arange(N) * S.T / N
     Fin = np.zeros((3, N))
     Fin[s - 1] = a * np.sin(w * t + phi)
@@ -422,32 +420,20 @@ def harmonic_balance(model: Model, values: dict, harmonic, samples: int = 32, to
     Ba = np.hstack([np.zeros((N, 1)), -hw**2 * c, hw**2 * sn])
     # the projection of r_j onto the harmonics' real and imaginary parts, the residual's scale
     Proj = np.vstack([np.ones((1, N)) / N, 2 / N * c.T, -2 / N * sn.T])
-    rows = np.concatenate([S.ri, S.nq + S.ri])
     jac = ode.jacobian(model).map(N)
 
     def samples_of(z):
         Z = z.reshape(2 * H + 1, n) * group
         return Bx @ Z, Bv @ Z, Ba @ Z
 
-    def residual(z, with_jacobian=False):
+    def residual(z):
+        """The scaled residual at z and its Jacobian."""
         x, xd, xdd = samples_of(z)
         Y = np.stack([S.state(x[j], xd[j]) for j in range(N)], axis=1)
-        if not with_jacobian:
-            acc = np.asarray(rhs(Y, ca.DM(S.P), Fin, np.zeros((3, N))))[S.nq + S.ri].T
-            return (Proj @ (xdd - acc) / (w**2 * group)).ravel()
         yd, Jy = jac(Y, ca.DM(S.P), Fin, np.zeros((3, N)))
         acc = np.asarray(yd)[S.nq + S.ri].T
         Jy = np.asarray(Jy).reshape(2 * S.nq, N, 2 * S.nq).transpose(1, 0, 2)  # (N, 22, 22): mapped column blocks
-        # d state / d (x, xd) per sample: the identity on the reduced rows, and gamma3's rate
-        # from the integral, minus the spin-free rate, whose derivative is exact (CasADi)
-        dY = np.zeros((N, 2 * S.nq, 2 * n))
-        dY[:, rows, np.arange(2 * n)] = 1.0
-        ia = [S.coords.index(c) for c in ANGLES]
-        red = [list(S.ri).index(i) for i in ia]
-        dr = np.asarray(_spin_free_rate_jacobian().map(N)(Y[ia], Y[[S.nq + i for i in ia]], S.values["u"],
-                                                          S.values["phi"] * 1.0)).reshape(N, 10)
-        dY[:, S.nq + S.k3, red] = -dr[:, :5]
-        dY[:, S.nq + S.k3, [n + i for i in red]] = -dr[:, 5:]
+        dY = S.state_jacobian(Y)  # d state / d (x, xd) per sample
         A = np.einsum("jrs,jsk->jrk", Jy[:, S.nq + S.ri, :], dY)  # (N, n, 2n): d acc / d (x, xd)
         Ax, Av = A[:, :, :n], A[:, :, n:]
         # d r_(j,i) / d z_(m,i') = (Ba[j,m] delta_ii' - Ax[j,i,i'] Bx[j,m] - Av[j,i,i'] Bv[j,m]) group_i'
@@ -461,7 +447,7 @@ def harmonic_balance(model: Model, values: dict, harmonic, samples: int = 32, to
     z[1] = S.X_lin.real / group
     z[H + 1] = S.X_lin.imag / group
     z = z.ravel()
-    r, Jm = residual(z, True)
+    r, Jm = residual(z)
     steps, first = 0, None
     while np.max(np.abs(r)) > tol:
         steps += 1
@@ -475,7 +461,7 @@ def harmonic_balance(model: Model, values: dict, harmonic, samples: int = 32, to
         if first_step_only:
             return unpack(z)[1], S.X_lin, {"newton_steps": steps, "first_correction": first, "converged": False,
                                            "frequency": w, "period": S.T, "group": group}
-        r, Jm = residual(z, True)
+        r, Jm = residual(z)
     return unpack(z)[1], S.X_lin, {"newton_steps": steps, "residual": float(np.max(np.abs(r))),
                                    "first_correction": 0.0 if first is None else first, "converged": True,
                                    "frequency": w, "period": S.T, "group": group}

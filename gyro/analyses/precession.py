@@ -429,7 +429,7 @@ def simulate(values: dict, t, level: str, rtol_scale: float = 1.0, base=None):
     check = _check_grid(t)
     if check is not None:  # the same motion on a denser grid, checked there (its time not the level's cost)
         grid, where = check
-        Yc = integrate(grid, _steps(level, len(grid)) if level == "full" else steps)
+        Yc = integrate(grid, _steps(level, len(grid)))
         Yc[where] = Y  # the answer is the asked grid's run, to its last bit
         Y = Yc
     tg = np.asarray(grid) * T  # the motion on the whole grid, checked there; answered at t

@@ -28,6 +28,7 @@ from gyro.errors import ParameterError
 from gyro.questions import Answer, unknown_kind
 
 NAME = "forced"
+VALUES = "amplitudes"  # the JSON key of the per-quantity answer (the scene table shows it)
 SAFETY = 2.0  # the linear level's estimate: this many times harmonic balance's first step
 ESTIMATE_NONLINEAR = 1e-8  # harmonic balance against the shooting: 4.4e-9 at most, measured
 

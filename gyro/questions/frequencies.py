@@ -16,6 +16,7 @@ import numpy as np
 from gyro.questions import Answer, unknown_kind
 
 NAME = "frequencies"
+VALUES = "frequencies"  # the JSON key of the per-quantity answer (the scene table shows it)
 EPS = np.finfo(float).eps
 
 

@@ -8,7 +8,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-VALUE_KEYS = ("frequencies", "amplitudes")  # a question's per-quantity answer, in its JSON
 
 # why a level was or was not enough for a set: the code of Trial.code
 NOT_REACHED, NOT_ANSWERED, EDGE, APRIORI, FAILED, QUESTION_EDGE, BOUND, ACCEPTED = range(8)
@@ -98,15 +97,15 @@ class Scene:
         lines = [f"{self.model}: {self.question} to a relative {self.tol:g}: level {d['level']}",
                  "levels tried, cheapest first:"]
         lines += [f"  {t['level']:<24} {t['reason']}" for t in d["tried"]]
-        # the per-quantity answer where the question gives one (frequencies, amplitudes)
-        key = next((c for c in VALUE_KEYS if isinstance(d.get(c), list) and len(d[c]) == len(self.quantities)), None)
-        values = d[key] if key else None
+        # the per-quantity answer where the question names one (its module's VALUES key)
+        vkey = getattr(self.answers[self.level[k]][0], "VALUES", None) if self.level[k] else None
+        values = d.get(vkey) if vkey else None
         lines.append(f"{'quantity':>12} {'value':>22} {'bound':>10}")
         for j, name in enumerate(self.quantities):
             v = f"{values[j]:22.15g}" if values is not None else f"{'':>22}"
             lines.append(f"{name:>12} {v} {self.bound[k][j]:10.2e}")
         for key, val in d.items():
-            if key not in ("model", "question", "tol", "level", "tried", *VALUE_KEYS, "quantities",
+            if key not in ("model", "question", "tol", "level", "tried", "frequencies", vkey, "quantities",
                            "error_bound", "seconds", "t", *self._long_keys(d)):
                 lines.append(f"{key}: {val}")
         lines.append(f"answered in {self.seconds:.3g} s")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import sysconfig
@@ -18,7 +19,13 @@ from tests.conftest import ROOT
 @pytest.fixture(scope="module")
 def installed(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("wheel")
-    proc = subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "--no-deps", "-q", "-w", str(tmp / "dist")],
+    # built from a copy of the sources: setuptools writes build/ into the tree it builds, and
+    # two workers of the parallel suite, each with one test of this module, built into the
+    # same build/ at once (a file vanished under the other's copy)
+    src = tmp / "src"
+    shutil.copytree(ROOT, src, ignore=shutil.ignore_patterns(".git", ".venv", "build", "*.egg-info", "__pycache__",
+                                                             ".pytest_cache"))
+    proc = subprocess.run([sys.executable, "-m", "pip", "wheel", str(src), "--no-deps", "-q", "-w", str(tmp / "dist")],
                           capture_output=True, text=True, cwd=tmp)
     assert proc.returncode == 0, proc.stderr[-2000:]
     (wheel,) = (tmp / "dist").glob("gyro_dynamics-*.whl")

@@ -37,7 +37,7 @@ from gyro.questions import frequencies as F  # noqa: E402
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"
 TG = load("torsion_gyrocompass")
-APPROXIMATE = ("formulas", "decoupled", "linear_paper", "linear_exact:companion", "linear_exact:polyroots")
+APPROXIMATE = ("formulas", "quartic", "decoupled", "linear_paper", "linear_exact:companion", "linear_exact:polyroots")
 GOALS = {"modes_1e-3_speedup": 100.0, "all_1e-3_speedup": 3.0, "tol_1e-9_slowdown": 1.2,
          "million_sets_1e-3_s": 60.0, "selector_overhead": 0.10}
 TOLS = (1e-2, 1e-5, 1e-9)
@@ -97,7 +97,7 @@ def per_set(fn, n: int, repeats: int = 3) -> float:
 
 def costs(quick: bool) -> dict:
     p0 = TG.vector()
-    batch = {"formulas": 200_000, "decoupled": 20_000, "linear_paper": 20_000, "linear_exact:companion": 5000,
+    batch = {"formulas": 200_000, "quartic": 20_000, "decoupled": 20_000, "linear_paper": 20_000, "linear_exact:companion": 5000,
              "linear_exact:default": 20_000, "linear_exact:polyroots": 100, "linear_exact:reference": 2}
     if quick:
         batch = {k: max(1, v // 10) for k, v in batch.items()}
@@ -142,8 +142,9 @@ def error_maps(quick: bool) -> tuple[dict, dict]:
             ans = F.answer(TG, lv, P, {})
             err = F.error(ans, ref)
             err[(ans.failed != "") | (ref.failed != "")] = np.nan
-            bound = hierarchy.bounds(TG, lv, "frequencies", P, err.shape[1]).total(ans.estimate)
-            trusted = np.isfinite(bound) & (F.edges(TG, ans, bound, range(bound.shape[1])) == "")[:, None]
+            B = hierarchy.bounds(TG, lv, "frequencies", P, err.shape[1])
+            bound = B.total(ans.estimate)
+            trusted = np.isfinite(bound) & (F.edges(TG, ans, bound, range(bound.shape[1]), B.answered) == "")[:, None]
             with np.errstate(all="ignore"):
                 ratio = np.where(trusted, err / bound, np.nan)
                 loose = np.where(trusted & (err > 0), bound / err, np.nan)
@@ -228,6 +229,33 @@ def speed(quick: bool) -> dict:
         "million_sets_1e-3": {"sets": m, "seconds": t_m * (1_000_000 / m), "measured_s": t_m, "levels": levels_used},
         "goals": GOALS,
     }
+
+
+def rungs(quick: bool) -> dict:
+    """How far above the cheapest level that was enough the selector goes: per tolerance,
+    the sets whose chosen level is more than one rung (a level answering every frequency,
+    cheapest first) above the cheapest level whose measured error meets tol / margin, for
+    margins 1, 2 and 5 (tests/test_hierarchy.py holds margin 5 at no set)."""
+    n = 100 if quick else 400
+    P = joint(n, seed=12)
+    ref = F.answer(TG, hierarchy.get(TG, "linear_exact:default"), P, {})
+    rungs_ = [lv for lv in hierarchy.levels(TG) if lv.answers_question("frequencies")
+              and all(hierarchy.bounds(TG, lv, "frequencies", P[:1], 10).answered)]
+    names = [lv.name for lv in rungs_]
+    err = {lv.name: F.error(F.answer(TG, lv, P, {}), ref) for lv in rungs_
+           if lv.cost <= hierarchy.get(TG, "linear_exact").cost}
+    out = {"sets": n, "rungs": names, "tolerances": {}}
+    for tol in (3e-2, 1e-3, 1e-4, 1e-6, 1e-9):
+        sc = select(TG, "frequencies", P, tol)
+        row = {"chosen": {str(k): int(v) for k, v in zip(*np.unique(sc.level, return_counts=True))}}
+        for margin in (1, 2, 5):
+            above = 0
+            for k in range(n):
+                need = [m for m, e in err.items() if np.all(e[k] <= tol / margin)] or [sc.level[k]]
+                above += names.index(sc.level[k]) > names.index(need[0]) + 1
+            row[f"more_than_one_rung_margin_{margin}"] = above
+        out["tolerances"][f"{tol:g}"] = row
+    return out
 
 
 # ------------------------------------------------------------------ figures
@@ -452,6 +480,7 @@ def main(argv=None) -> int:
     out["error_maps"] = stats
     out["gimbal_error_map"] = gimbal_map(args.quick)
     print(f"error maps: {time.perf_counter() - t0:.0f} s", flush=True)
+    out["rungs"] = rungs(args.quick)
     out["figures"] = error_figures(samples)
     scenes(args.quick)
     print(f"figures: {time.perf_counter() - t0:.0f} s", flush=True)

@@ -128,13 +128,18 @@ class Variant:
 
     `approximate` maps one entry of M, D or K (taken at q = 0) to the paper's approximation;
     `row_scale` divides each equation as the print does; `printed(p)` returns the printed
-    diagonal blocks; `corrections(p)` the entries where print and derivation differ."""
+    diagonal blocks; `corrections(p)` the entries where print and derivation differ.
+    `perturbations` names parameters whose first-order effect on each block's
+    characteristic polynomial is emitted (`<variant>_charpoly_d<name>`: the coefficients
+    differentiated by the parameter), for a level that evaluates the polynomial at a limit
+    of that parameter and estimates the roots' shift to its actual value."""
 
     approximate: Callable
     row_scale: dict
     printed: Callable | None = None
     corrections: Callable | None = None
     doc: str = ""
+    perturbations: tuple = ()
 
 
 @dataclass(frozen=True)

@@ -60,7 +60,7 @@ def spread_corners(model) -> np.ndarray:
 
 
 def test_every_model_declares_its_levels_and_they_read_back_cheapest_first():
-    for name, expect in ((TG, {"formulas", "decoupled", "linear_paper", "linear_exact:default",
+    for name, expect in ((TG, {"formulas", "quartic", "decoupled", "linear_paper", "linear_exact:default",
                                "linear_exact:companion", "linear_exact:polyroots", "linear_exact:reference"}),
                          ("gimbal_gyroscope", {"closed_form", "integrated:DOP853", "integrated:Radau"}),
                          ("gyrohorizoncompass", {"linear_exact:default", "linear_exact:reference"})):
@@ -120,15 +120,18 @@ def torsion_errors(tg):
     P = np.concatenate([spread_corners(tg), spread_sets(tg, 300, seed=20)])
     ref = F.answer(tg, hierarchy.get(tg, "linear_exact:default"), P, {})
     out = {}
-    for name in ("formulas", "decoupled", "linear_paper", "linear_exact:companion"):
+    for name in LEVELS:
         lv = hierarchy.get(tg, name)
         ans = F.answer(tg, lv, P, {})
-        bound = hierarchy.bounds(tg, lv, "frequencies", P, 10).total(ans.estimate)
-        out[name] = (ans, F.error(ans, ref), bound)
+        B = hierarchy.bounds(tg, lv, "frequencies", P, 10)
+        out[name] = (ans, F.error(ans, ref), B.total(ans.estimate), B.answered)
     return P, ref, out
 
 
-@pytest.mark.parametrize("name", ["formulas", "decoupled", "linear_paper", "linear_exact:companion"])
+LEVELS = ("formulas", "quartic", "decoupled", "linear_paper", "linear_exact:companion")
+
+
+@pytest.mark.parametrize("name", LEVELS)
 def test_no_bound_is_beaten_on_the_spreads_and_held_out_sets(tg, torsion_errors, name):
     """Wherever a level gives a finite bound outside the question's edges (veering: two
     modes within their bounds of each other), the measured error is below it. The
@@ -138,8 +141,8 @@ def test_no_bound_is_beaten_on_the_spreads_and_held_out_sets(tg, torsion_errors,
     from gyro.questions import frequencies as F
 
     P, ref, errs = torsion_errors
-    ans, err, bound = errs[name]
-    edge = F.edges(tg, ans, bound, range(10))
+    ans, err, bound, answered = errs[name]
+    edge = F.edges(tg, ans, bound, range(10), answered)
     trusted = np.isfinite(bound) & (edge == "")[:, None]
     assert trusted.sum() > 0.3 * trusted.size  # the test holds something
     allow = bound + ref.estimate
@@ -151,11 +154,92 @@ def test_the_approximate_operators_are_close_to_their_bounds_where_they_matter(t
     """The bounds are not vacuous: the worst measured error reaches a tenth of the
     paper operator's bound (the sag terms it carries are the largest it drops)."""
     _, _, errs = torsion_errors
-    _, err, bound = errs["linear_paper"]
+    _, err, bound, _ = errs["linear_paper"]
     assert np.nanmax(err / bound) > 0.1
 
 
 # ------------------------------------------------------------------ the selector
+
+
+# ------------------------------------------------------------------ the quartic level
+
+
+def _nutation_block(tg, P, g):
+    from gyro.kernels import function
+
+    Q = P.copy()
+    Q[:, tg.param_names.index("u")] = 0.0
+    Q[:, tg.param_names.index("g")] = g
+    return np.reshape(function(tg, "paper_charpoly")(Q)[1], (len(P), -1)), Q
+
+
+def test_the_emitted_gravity_derivative_is_that_of_the_block_polynomial(tg):
+    """paper_charpoly_dg, the derivation's d/dg of the J'' block's coefficients, against a central
+    difference of paper_charpoly in g at u = 0, at g = 0 and at the example's g (each
+    coefficient, relative to its size: the difference's truncation and rounding, 1e-6)."""
+    from gyro.kernels import function
+
+    P = tg.vector()[None, :]
+    for g in (0.0, 9.81):
+        _, Q = _nutation_block(tg, P, g)
+        d = np.reshape(function(tg, "paper_charpoly_dg")(Q)[1], -1)
+        h = 1e-3
+        fd = (_nutation_block(tg, P, g + h)[0] - _nutation_block(tg, P, g - h)[0])[0] / (2 * h)
+        scale = np.maximum(np.abs(fd), np.abs(_nutation_block(tg, P, 9.81)[0][0]) * 1e-9)
+        assert np.all(np.abs(d - fd) <= 1e-6 * scale + 1e-300), (g, d, fd)
+        assert np.any(d != 0)
+
+
+def test_the_quartic_levels_nutation_roots_are_the_paper_quartics_moved_by_gravity(tg):
+    """Its four nutation roots, before the shift, are the quartic (3.10)'s (the paper's
+    'computed' 51.969, 359.98, 644.45, and 3851.09 at Omega = 3769.3, docs/frequencies.md);
+    the first-order gravity shift takes the first nutation root (5.6 % below J'' with
+    gravity) to within 1.2 % of that shift (measured; the second order, about the shift
+    squared), and the level answers it within its bound."""
+    from gyro.questions import frequencies as F
+
+    P = tg.vector()[None, :]
+    c0, _ = _nutation_block(tg, P, 0.0)
+    z0 = np.roots(c0[0, 2:][::-1])
+    assert np.sort(np.sqrt(-z0.real)) == pytest.approx([51.96892, 359.98405, 644.44983, 3851.08874], rel=1e-6)
+    cg, _ = _nutation_block(tg, P, tg.defaults["g"])
+    with_g = np.sort(np.sqrt(-np.roots(cg[0][::-1]).real[np.abs(np.roots(cg[0][::-1])) > 1e3]))
+    lv = hierarchy.get(tg, "quartic")
+    ans = F.answer(tg, lv, P, {})
+    first = with_g[0]  # the first nutation root with gravity, ~55 rad/s
+    j = int(np.argmin(np.abs(ans.values[0] - first)))
+    shift = abs(first - 51.96892)
+    assert shift / first > 0.05
+    assert abs(ans.values[0, j] - first) < 0.02 * shift
+    B = hierarchy.bounds(tg, lv, "frequencies", P, 10).total(ans.estimate)
+    assert abs(ans.values[0, j] - first) / first <= B[0, j]
+
+
+def test_the_quartic_answers_the_nutation_modes_the_formulas_cannot(tg):
+    """At the example, 1e-3 on omega6, omega7 and omega10 (three nutation roots): (3.26)'s
+    estimate mu1 + kappa6 is 8.5e-2, the quartic's roots promise 3e-4."""
+    s = select(tg, "frequencies", tg.vector()[None, :], 1e-3, {"modes": [6, 7, 10]})
+    assert s.level[0] == "quartic"
+    assert [lv for lv, _ in s.tried(0)] == ["formulas", "quartic"]
+
+
+def test_a_mode_answered_without_a_bound_leaves_no_rank_decided(tg):
+    """A mode a level answers but cannot bound (a root whose first-order shift is >= 1/2,
+    a lost root) may lie anywhere, so no rank is decided: at spin / 10 the quartic's
+    uncorrected first nutation root, 18.2 rad/s, is 26.0 with gravity, past omega4 = 19.03.
+    A mode the level declares unanswered (decoupled's omega1, zero at u = 0) keeps its rank."""
+    from gyro.questions import frequencies as F
+
+    f = np.array([[3.2e-2, 5.07, 5.44, 18.2, 19.03, 487.2, 644.5, 780.0, 812.3, 1114.2]])
+    bound = np.full((1, 10), 1e-4)
+    bound[0, 3] = np.inf
+    ans = F.Answer(f, None, np.array([""], object), {})
+    edge = F.edges(tg, ans, bound, [4], np.ones(10, bool))
+    assert "mode 4 without a bound" in edge[0]
+    assert F.edges(tg, ans, bound, [4], np.arange(10) != 3)[0] == ""
+    P = tg.vector()[None, :]
+    s = select(tg, "frequencies", P, 1e-3, {"modes": [2]}, among=["decoupled"])
+    assert s.level[0] == "decoupled"  # its omega1 declared unanswered: omega2's rank holds
 
 
 def test_the_selector_goes_up_the_hierarchy_with_the_tolerance(tg):
@@ -178,13 +262,23 @@ def test_a_batch_gets_a_level_per_set_and_says_which(tg):
     assert any(r.startswith("a-priori bound") for lv, r in s.tried(2) if lv == "linear_paper")
 
 
+# The approximate levels' bounds are up to this many times their error where they are tight:
+# the derived estimates are twice the first-order error by construction, the paper operator's
+# error reaches 0.21 of its bound (bench/results/levels.json), so a level is needed where its
+# error is below tol / 5.
+LOOSENESS = 5.0
+
+
 @settings(max_examples=30, deadline=None, derandomize=True, phases=[Phase.explicit, Phase.generate])
 @given(st.integers(0, 2**31 - 1), st.sampled_from([3e-2, 1e-3, 1e-4, 1e-6, 1e-9]))
 def test_the_actual_error_never_exceeds_the_tolerance(seed, tol):
     """Random sets of the spreads and random tolerances: the selected level's frequencies
     lie within tol of the exact ones, and the chosen level is at most one rung above the
-    cheapest level whose measured error meets tol (rungs: the levels that answer every
-    requested quantity, cheapest first). The exact frequencies are the default method's,
+    cheapest level whose measured error meets tol with the margin its bound needs, tol /
+    LOOSENESS (rungs: the levels that answer every requested quantity, cheapest first).
+    Without the margin the selector cannot know that a level whose bound exceeds tol is
+    within it all the same (bench/levels.py 'rungs': 15 of 400 sets at 1e-3 go two rungs
+    up). The exact frequencies are the default method's,
     whose own error (its estimate, <= 1e-10 relative) is added to the allowance: the
     comparison |f - f_default| <= (tol + e_default) f follows from |f - f_exact| <= tol f."""
     from gyro import ladder
@@ -207,7 +301,7 @@ def test_the_actual_error_never_exceeds_the_tolerance(seed, tol):
         f = np.array(s.document(k)["frequencies"])
         allow = (tol + ref.error_estimate[k]) * ref.frequencies[k]
         assert np.all(np.abs(f - ref.frequencies[k]) <= allow), (s.level[k], tol)
-        adequate = [n for n, e in measured.items() if np.all(e[k] <= tol)] or [s.level[k]]
+        adequate = [n for n, e in measured.items() if np.all(e[k] <= tol / LOOSENESS)] or [s.level[k]]
         assert names.index(s.level[k]) <= names.index(adequate[0]) + 1, (s.level[k], adequate, tol)
 
 

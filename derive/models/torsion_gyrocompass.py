@@ -475,6 +475,13 @@ def section3_formulas():
     quartic = sp.Poly(sp.expand(K0 * L_poly(zs, b1) - zs * m_s * L_poly(zs, b2)), zs)
     for k_, c in enumerate(reversed(quartic.all_coeffs())):
         put(f"quartic_c{k_}", c, f"(3.10): coefficient of z^{k_} in K0 L(z,b') - z m_* L(z,b'')")
+    # the a-priori bounds of the levels on the paper's operator (levels(), docs/hierarchy.md)
+    beta0, gamma20 = H * u3 / (G + H * u2), H * u3 / Kgamma
+    paper = put("bound_paper", F["eps2"] + m * g / (Kp * sp.Abs(l2)) + sp.Abs(beta0) + sp.Abs(gamma20) + u / F["Omega"],
+                "the bound of the paper operator (2.4) against the exact one: eps2 + m g/(K_p |l2|) (the "
+                "sag) + |beta0| + |gamma2| of (2.2) + u/Omega")
+    put("bound_blocks", paper + 2 * (H * u2 / Kgamma + H * u2 / G) + 2 * F["eps1"],
+        "the bound of the decoupled blocks (u = 0 in (2.4)): bound_paper + 2 (H u2/K_gamma + H u2/G) + 2 eps1")
     return F, doc
 
 
@@ -527,14 +534,18 @@ def levels(F):
     the Earth-rate coupling of the blocks: 2 u2/omega for the Coriolis terms (largest at
     the slowest coupled mode, eps1 = u sqrt(l/g)), H u2/K_gamma and H u2/G against the
     stiffnesses; twice their sum (measured: at most 0.43 of it); omega1 (zero at u = 0) is
-    not answered. The formulas' bound is their derived estimate (mode_formulas)."""
+    not answered. The quartic level takes the nutation modes from the g = 0 quartic (3.10)
+    (J'' at u = g = 0), each moved by its first-order gravity shift dz = -g F_g/F_z (F the J''
+    polynomial, F_g derived from d/dg of its coefficients), and the other modes from their
+    formulas: per mode its estimate, a formula's, or for a nutation root decoupled's bound
+    plus the first-order shift itself as the size of the second-order remainder (measured:
+    at most 0.34 of the whole over the spreads). The formulas' bound is their derived
+    estimate (mode_formulas)."""
     from derive.model import Bound, Level
 
-    sag = m * g / (Kp * sp.Abs(l2))
-    beta0 = H * u3 / (G + H * u2)
-    gamma20 = H * u3 / Kgamma
-    paper = F["eps2"] + sag + sp.Abs(beta0) + sp.Abs(gamma20) + u / F["Omega"]
-    coupling = 2 * (H * u2 / Kgamma + H * u2 / G) + 2 * F["eps1"]
+    paper, blocks = F["bound_paper"], F["bound_blocks"]
+    blocks_edges = {"Earth rate below the slowest pendulum frequency (eps1 < 1/4)": sp.Rational(1, 4) - F["eps1"],
+                    "l2 != 0 (the sag's bound)": sp.Abs(l2)}
     n = len(REDUCED)
     exact = "nothing of the linearised motion about the exact equilibrium (amplitudes, nonlinearity)"
     return [
@@ -542,11 +553,21 @@ def levels(F):
               {"kind": "spectrum", "method": "formulas"}, {"frequencies": Bound(estimate=True)},
               reference="linear_exact",
               doc="the paper's approximate formulas, corrected, with their derived estimates"),
+        Level("quartic", "gravity in the nutation modes (the g = 0 quartic (3.10) of J'' at u = 0), and what "
+                         "decoupled neglects; the other modes by their formulas",
+              {"kind": "formulas", "roots": {"function": "paper_charpoly", "block": 2, "set": {"u": 0.0, "g": 0.0},
+                                             "modes": ["nutation a", "nutation b", "nutation c", "nutation d"],
+                                             "shift": {"parameter": "g", "function": "paper_charpoly_dg", "correct": True},
+                                             "apriori": "bound_blocks"}},
+              {"frequencies": Bound(estimate=True)},
+              valid=blocks_edges,
+              cost=1.0e-5, reference="linear_exact",
+              doc="the roots of the quartic (3.10) for the four nutation modes, with twice the first-order "
+                  "gravity shift of each as its estimate; the other six modes by (3.2)-(3.9)"),
         Level("decoupled", "the Earth-rate coupling of the two blocks (eps1 = 0, (3.1)), and what (2.4) drops",
               {"kind": "charpoly", "function": "paper_charpoly", "set": {"u": 0.0}},
-              {"frequencies": [None] + [Bound(paper + coupling, estimate=True)] * (n - 1)},
-              valid={"Earth rate below the slowest pendulum frequency (eps1 < 1/4)": sp.Rational(1, 4) - F["eps1"],
-                     "l2 != 0 (the sag's bound)": sp.Abs(l2)},
+              {"frequencies": [None] + [Bound(blocks, estimate=True)] * (n - 1)},
+              valid=blocks_edges,
               cost=1.6e-5, reference="linear_exact",
               doc="the blocks J', J'' of (2.4) at u = 0: roots of their characteristic polynomials"),
         Level("linear_paper", "linearisation at q = 0 (offsets of (2.2)), u3 terms, u^2 terms, A u and I_i u against H",
@@ -596,7 +617,8 @@ def build():
             approximate=paper_approximation, row_scale=PRINT_ROW_SCALE,
             printed=printed_operator, corrections=print_corrections,
             doc="the paper's printed operator (2.4): linearised at q = 0, u3 dropped, u^2 "
-                "dropped, A u and I_i u neglected against H")},
+                "dropped, A u and I_i u neglected against H",
+            perturbations=("g",))},
         formulas=formulas, formula_docs=docs, mode_formulas=mode_formulas(formulas),
         levels=levels(formulas),
     )

@@ -74,7 +74,7 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
         ks = pending[sub]
         ans = q.answer(model, lv, P[ks], opts)
         total = hierarchy.Bounds(B.apriori[sub], B.estimate, B.invalid[sub], B.answered, B.bad[sub]).total(ans.estimate)
-        edge = q.edges(model, ans, total, idx)
+        edge = q.edges(model, ans, total, idx, B.answered)
         worst = total[:, idx].max(axis=1) if idx else np.zeros(sub.size)
         failed, crossed = ans.failed != "", edge != ""
         ok = ~failed & ~crossed & (worst <= tol)

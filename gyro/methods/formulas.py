@@ -37,8 +37,21 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None) -> Spectrum:
         return Spectrum("formulas", f, np.zeros(f.shape), e, growth_known=False)
     if P.shape[0] > CHUNK:  # cache-sized pieces: the selection is memory-bound
         return Spectrum.concat([solve(model, P[s]) for s in chunks(P.shape[0], CHUNK)])
+    f, e = per_mode(model, P, model.numpy.mode_formulas)
+    order = np.argsort(f, axis=1, kind="stable")  # as the C's insertion sort: ties keep their order
+    f, e = np.take_along_axis(f, order, 1), np.take_along_axis(e, order, 1)
+    return Spectrum("formulas", f, np.zeros(f.shape), e, growth_known=False)
+
+
+def per_mode(model: Model, P: np.ndarray, evaluate=None) -> tuple[np.ndarray, np.ndarray]:
+    """(frequencies, estimates), (sets, modes) in the rows of metadata 'mode_formulas' (not
+    sorted): per mode the candidate whose own estimate is smallest; the estimate infinite
+    where that formula is outside its domain (0/0, a negative square). `evaluate` is the
+    generated mode_formulas (default: compiled where there is a compiler)."""
+    from gyro.kernels import function
+
     with np.errstate(all="ignore"):
-        omega, estimate = getattr(model.numpy, "mode_formulas")(P)
+        omega, estimate = (evaluate or function(model, "mode_formulas"))(P)
     N = P.shape[0]
     n = len(model.meta["mode_formulas"])
     omega, estimate = np.reshape(omega, (N, n, -1)), np.reshape(estimate, (N, n, -1))
@@ -47,7 +60,6 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None) -> Spectrum:
         better = estimate[..., j] < e
         f = np.where(better, omega[..., j], f)
         e = np.where(better, estimate[..., j], e)
-    e = np.where(np.isfinite(f) & (f > 0), e, np.inf)  # a formula outside its domain (0/0)
-    order = np.argsort(f, axis=1, kind="stable")  # as the C's insertion sort: ties keep their order
-    f, e = np.take_along_axis(f, order, 1), np.take_along_axis(e, order, 1)
-    return Spectrum("formulas", f, np.zeros(f.shape), e, growth_known=False)
+    with np.errstate(invalid="ignore"):
+        e = np.where(np.isfinite(f) & (f > 0), e, np.inf)
+    return f, e

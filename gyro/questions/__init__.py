@@ -9,8 +9,9 @@ A question module has NAME (the command line's name) and:
 - `answer(model, level, P, opts) -> Answer`: the level's answer over a batch, by the
   level's evaluator kind (`level.evaluator["kind"]`); a kind the question does not know
   is a ValueError naming it;
-- `edges(model, answer, bound, idx) -> array of str`: per set, the question's own edge of
-  validity crossed ('' where none: veering of two modes, a merged root, no verdict);
+- `edges(model, answer, bound, idx, answered) -> array of str`: per set, the question's own
+  edge of validity crossed ('' where none: veering of two modes, a merged root, no
+  verdict); `answered` (quantities,) is False where the level declares no bound;
 - `error(answer, reference) -> (sets, quantities)`: the relative error against another
   level's answer (error maps);
 - `document(model, answer, k, idx) -> dict`: the question's JSON keys for set k.

@@ -86,7 +86,7 @@ def answer(model, level, P, opts) -> Answer:
     return Answer(np.abs(X), est, failed, {"X": X, "scale": scale, "frequency": freq})
 
 
-def edges(model, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
+def edges(model, ans: Answer, bound: np.ndarray, idx, answered) -> np.ndarray:
     return np.full(ans.values.shape[0], "", object)
 
 

@@ -80,22 +80,76 @@ def _poly_roots(c: np.ndarray):
     return z, est
 
 
-def _charpoly(model, level, P):
+def _overridden(model, P, values: dict) -> np.ndarray:
+    P = P.copy()
+    for name, value in values.items():
+        P[:, model.param_names.index(name)] = value
+    return P
+
+
+def _block_roots(model, spec: dict, P):
+    """Roots in z = p^2 of the blocks of an emitted function (spec "function"; only block
+    spec["block"], counted from 1, if given) at the parameters overridden by spec "set",
+    with the exact zero roots there removed (a mode that the limit takes to zero is not
+    answered); and each root's relative error estimate: its rounding, and, with spec
+    "shift" = {"parameter": NAME, "function": D}, twice the first-order shift of z to the
+    parameter's actual value, |dz/z| with dz = -(actual - set) D(z)/c'(z), D the emitted
+    d/dNAME of the coefficients (the relative shift of a frequency is half that of its z);
+    with "correct": true in the shift, the roots are moved by dz and the estimate of the
+    second-order remainder is the first-order shift itself, |dz/z|/2.
+    Without "block", the zero roots stay, as exact zeros with an infinite estimate.
+    -> (z, the relative error estimate of each root's frequency), each (sets, roots)."""
     from gyro.kernels import function
 
-    ev = level.evaluator
-    P = P.copy()
-    for name, value in ev.get("set", {}).items():
-        P[:, model.param_names.index(name)] = value
-    blocks = function(model, ev["function"])(P)
-    zs, es = zip(*(_poly_roots(np.reshape(b, (P.shape[0], -1))) for b in blocks))
-    z, est = np.concatenate(zs, axis=1), np.concatenate(es, axis=1)
+    Ps = _overridden(model, P, spec.get("set", {}))
+    N = P.shape[0]
+    blocks = [np.reshape(b, (N, -1)) for b in function(model, spec["function"])(Ps)]
+    pick = [spec["block"] - 1] if "block" in spec else range(len(blocks))
+    shift = spec.get("shift")
+    dblocks = None
+    if shift:
+        dblocks = [np.reshape(b, (N, -1)) for b in function(model, shift["function"])(Ps)]
+        ip = model.param_names.index(shift["parameter"])
+        delta = P[:, ip] - Ps[:, ip]
+    zs, es = [], []
+    for i in pick:
+        c = blocks[i]
+        zero = np.all(c == 0, axis=0)  # coefficients zero in every set: exact zero roots
+        k0 = int(np.argmin(zero)) if not zero.all() else c.shape[1]
+        z, est = _poly_roots(c[:, k0:])
+        est = est / 2  # a frequency's relative error is half that of its z
+        z = np.concatenate([np.zeros((N, k0), complex), z], axis=1) if "block" not in spec else z
+        est = np.concatenate([np.full((N, k0), np.inf), est], axis=1) if "block" not in spec else est
+        if shift:
+            with np.errstate(all="ignore"):
+                k = np.arange(c.shape[1])
+                dc = (c[:, 1:] * k[1:])
+                zz = z[..., None]
+                der = np.sum(dc[:, None, :] * zz ** k[None, None, :-1], axis=2)
+                dF = np.sum(dblocks[i][:, None, :] * zz ** k[None, None, :], axis=2)
+                dz = -delta[:, None] * dF / der
+                if shift.get("correct"):  # the roots moved by it; what remains is of second order
+                    z = z + dz
+                    est = est + np.abs(dz / z) / 2
+                else:
+                    est = est + np.abs(dz / z)
+        zs.append(z)
+        es.append(est)
+    return np.concatenate(zs, axis=1), np.concatenate(es, axis=1)
+
+
+def _frequency(z):
     p = np.sqrt(z)
     p = np.where(p.imag < 0, -p, p)
-    freq, growth = np.abs(p.imag), p.real
-    # a frequency's relative error is half that of its z; an exact zero root (a free
-    # direction, as the neutral azimuth at u = 0) has no relative error to give
-    est = np.where(z == 0, np.inf, est / 2)
+    return np.abs(p.imag), p.real
+
+
+def _charpoly(model, level, P):
+    z, est = _block_roots(model, level.evaluator, P)
+    freq, growth = _frequency(z)
+    # an exact zero root (a free direction, as the neutral azimuth at u = 0) has no
+    # relative error to give
+    est = np.where(z == 0, np.inf, est)
     f, e, g = _ascending(freq, est, growth)
     e = np.where(np.isfinite(e) & (e < 0.5), e, np.inf)
     failed = np.full(f.shape[0], "", object)
@@ -103,7 +157,41 @@ def _charpoly(model, level, P):
     return Answer(f, e, failed, {"growth": g})
 
 
-EVALUATORS = {"spectrum": _spectrum, "charpoly": _charpoly}
+def _formulas(model, level, P):
+    """The model's mode formulas (metadata 'mode_formulas', per mode the candidate with the
+    smallest estimate), the modes named in the evaluator's "roots" {"modes": [...], and a
+    `_block_roots` spec} replaced by that block's roots: as the paper's nutation formulas
+    (3.26) by the roots of the quartic (3.10) they approximate. "apriori" names an emitted
+    formula (metadata 'formulas') added to the roots' estimates: the bound of the operator
+    the block comes from, which the other modes' formulas, measured against the exact
+    operator, do not carry. A block without one nonzero root per replaced mode is refused."""
+    from gyro.methods.formulas import per_mode
+
+    f, e = per_mode(model, P)
+    spec = level.evaluator.get("roots")
+    failed = np.full(f.shape[0], "", object)
+    if spec:
+        rows = [[m["mode"] for m in model.meta["mode_formulas"]].index(x) for x in spec["modes"]]
+        z, est = _block_roots(model, spec, P)
+        if z.shape[1] != len(rows):
+            raise ValueError(f"level {level.name}: its block has {z.shape[1]} nonzero roots for "
+                             f"{len(rows)} replaced modes")
+        freq, _ = _frequency(z)
+        if "apriori" in spec:  # the bound of the model the roots come from, for them alone
+            from gyro.kernels import function
+
+            names = [x["name"] for x in model.meta["formulas"]]
+            with np.errstate(all="ignore"):
+                (values,) = function(model, "formulas")(P)
+            est = est + np.abs(np.reshape(values, (P.shape[0], -1))[:, [names.index(spec["apriori"])]])
+        f[:, rows] = freq
+        e[:, rows] = np.where(np.isfinite(est) & (est < 0.5), est, np.inf)
+    f, e, _ = _ascending(f, e, np.zeros(f.shape))
+    failed[~np.all(np.isfinite(f), axis=1)] = "a frequency could not be computed"
+    return Answer(f, e, failed, {})
+
+
+EVALUATORS = {"spectrum": _spectrum, "charpoly": _charpoly, "formulas": _formulas}
 
 
 def answer(model, level, P, opts) -> Answer:
@@ -113,24 +201,31 @@ def answer(model, level, P, opts) -> Answer:
     return EVALUATORS[kind](model, level, P)
 
 
-def edges(model, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
+def edges(model, ans: Answer, bound: np.ndarray, idx, answered) -> np.ndarray:
     """'' per set, or the reason the bound is no promise there: two neighbouring modes (in
     rank, among all of them; answers are ascending in frequency, `_ascending`) whose
-    intervals omega (1 +- bound) touch."""
+    intervals omega (1 +- bound) touch; or a mode the level answers (`answered`) without a
+    finite bound, whose place among the others is then unknown, so that no rank is decided.
+    A mode the level declares unanswered keeps its rank by the declaration (the neutral
+    azimuth at u = 0, below every other mode)."""
     f = ans.values
     out = np.full(f.shape[0], "", object)
+    answered = np.asarray(answered, bool)
     with np.errstate(invalid="ignore"):
         lo, hi = f * (1 - bound), f * (1 + bound)
         touch = hi[:, :-1] >= lo[:, 1:]  # rank j and j + 1
     want = np.zeros(f.shape[1], bool)
     want[list(idx)] = True
     relevant = want[:-1] | want[1:]
-    # a mode a level leaves unanswered (bound inf) is, by the level's declaration, one that
-    # keeps its rank (the neutral azimuth at u = 0 below every other mode)
     touch &= relevant[None, :] & np.isfinite(bound[:, :-1]) & np.isfinite(bound[:, 1:])
     for k in np.flatnonzero(touch.any(axis=1)):
         j = int(np.flatnonzero(touch[k])[0])
         out[k] = f"modes {j + 1} and {j + 2} within their bounds of each other (veering or a merged root)"
+    if want.any():
+        lost = ~np.isfinite(bound) & answered[None, :]
+        for k in np.flatnonzero(lost.any(axis=1) & (out == "")):
+            j = int(np.flatnonzero(lost[k])[0])
+            out[k] = f"mode {j + 1} without a bound: its place among the others, and so every rank, is not decided"
     return out
 
 

@@ -107,7 +107,7 @@ def answer(model, level, P, opts) -> Answer:
     return Answer(values, est, failed, {"t": np.broadcast_to(t, (N, t.size)), "scale": scales})
 
 
-def edges(model, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
+def edges(model, ans: Answer, bound: np.ndarray, idx, answered) -> np.ndarray:
     return np.full(ans.values.shape[0], "", object)
 
 

@@ -53,7 +53,7 @@ def answer(model, level, P, opts) -> Answer:
                    "growth": spec.growth, "frequencies": spec.frequencies})
 
 
-def edges(model, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
+def edges(model, ans: Answer, bound: np.ndarray, idx, answered) -> np.ndarray:
     return np.full(ans.values.shape[0], "", object)
 
 

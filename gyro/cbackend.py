@@ -327,6 +327,30 @@ def mode_formulas_selected(model_name: str) -> ModeFormulasSelected:
     return _built(ModeFormulasSelected, model_name)
 
 
+class PolyRoots:
+    """The generated polynomial roots with inclusion radii (templates/polyroots.c.j2;
+    gyro.roots in C), in any model's library: it knows no model."""
+
+    def __init__(self, model_name: str):
+        self._fn = _entry(model_name, f"{model_name}_poly_roots_batch")
+
+    def __call__(self, c):
+        """c (sets, degree + 1), lowest first. Returns (z complex, relative radius, relative
+        sensitivity to the coefficients' rounding, ok)."""
+        c = np.ascontiguousarray(c, dtype=float)
+        _check(c.ndim == 2 and c.shape[1] >= 2, "coefficients must be (sets, degree + 1)")
+        n, d = c.shape[0], c.shape[1] - 1
+        z, rad, sens, ok = np.empty((n, d), complex), np.empty((n, d)), np.empty((n, d)), np.empty(n)
+        ptr = ctypes.POINTER(ctypes.c_double)
+        self._fn(ctypes.c_long(n), ctypes.c_long(d), *[a.ctypes.data_as(ptr) for a in (c, z, rad, sens, ok)])
+        return z, rad, sens, ok.astype(bool)
+
+
+def poly_roots(model_name: str) -> PolyRoots:
+    """The compiled polynomial roots of a model's library (CompilerUnavailable without one)."""
+    return _built(PolyRoots, model_name)
+
+
 class SensitivityNullVectors:
     """The generated null vectors of the roots (templates/sensitivity.c.j2;
     gyro.analyses.sensitivity._null_vectors with one LU per root, in C)."""

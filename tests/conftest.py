@@ -23,12 +23,29 @@ TIERS = {
               "test_gimbal_section6", "test_gimbal_paper_items", "test_paper_items",
               "test_gyrohorizoncompass", "test_verdict", "test_ghc_paper_items", "test_precession",
               "test_precession_base"),
-    "methods": ("test_ladder", "test_companion_bound", "test_sensitivity", "test_hierarchy", "test_scene_figures", "test_harmonic", "test_block_starts", "test_anymodel"),
+    "methods": ("test_ladder", "test_companion_bound", "test_sensitivity", "test_hierarchy", "test_scene_figures", "test_harmonic", "test_block_starts", "test_anymodel",
+                "test_roots"),
     "properties": ("test_properties",),
     "cli": ("test_cli", "test_gimbal_simulate", "test_readme", "test_sweep", "test_wheel", "test_ghc_cli", "test_fuzz", "test_robustness",
             "test_tolerance", "test_executor", "test_precession_cli", "test_forced", "test_unbalance_lagrangian"),
 }
 _TIER_OF = {f: tier for tier, files in TIERS.items() for f in files}
+
+
+def pytest_sessionstart(session):
+    """Every generated model's C compiled once before the tests (in the controlling process
+    only): the command-line tests hold stderr to one line, and the first use of a library
+    after its C changed says on stderr that it compiles it."""
+    if hasattr(session.config, "workerinput"):
+        return
+    from gyro import cbackend
+    from gyro.catalog import available
+
+    for name in available():
+        try:
+            cbackend.library(name)
+        except cbackend.CompilerUnavailable:
+            pass  # the tests that need the compiler say so themselves
 
 
 def pytest_collection_modifyitems(config, items):

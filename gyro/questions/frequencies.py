@@ -17,7 +17,6 @@ from gyro.questions import Answer, unknown_kind
 
 NAME = "frequencies"
 VALUES = "frequencies"  # the JSON key of the per-quantity answer (the scene table shows it)
-EPS = np.finfo(float).eps
 
 
 def quantities(model, opts) -> list[str]:
@@ -56,28 +55,16 @@ def _spectrum(model, level, P):
     return Answer(f, e, failed, {"growth": g})
 
 
-def _poly_roots(c: np.ndarray):
+def _poly_roots(c: np.ndarray, model=None):
     """Roots of polynomials with coefficients c (sets, degree + 1), lowest first, over the
-    batch (eigenvalues of each companion matrix), with the first-order sensitivity of
-    each root to a rounding of eps per coefficient: eps sum |c_k| |z|^k / |c'(z)| / |z|."""
-    N, d1 = c.shape
-    d = d1 - 1
-    lead = c[:, -1]
-    C = np.zeros((N, d, d))
-    C[:, 1:, :-1] = np.eye(d - 1)
-    with np.errstate(all="ignore"):
-        C[:, :, -1] = -c[:, :-1] / lead[:, None]
-        good = np.all(np.isfinite(C), axis=(1, 2))
-        z = np.full((N, d), np.nan + 0j)
-        if good.any():
-            z[good] = np.linalg.eigvals(C[good])
-        k = np.arange(d1)
-        az = np.abs(z)
-        num = np.sum(np.abs(c)[:, None, :] * az[..., None] ** k, axis=2)
-        dc = c[:, 1:] * np.arange(1, d1)
-        der = np.abs(np.sum(dc[:, None, :] * z[..., None] ** np.arange(d), axis=2))
-        est = 4 * d * EPS * num / (der * az)
-    return z, est
+    batch (gyro.roots: each with a proven inclusion radius for the coefficients as given),
+    and each root's relative error estimate: that radius plus the first-order sensitivity
+    of the root to a rounding of eps per coefficient (inf where no radius is proven: a
+    merged root, a cluster)."""
+    from gyro.roots import roots
+
+    z, radius, sensitivity, _ = roots(c, model)
+    return z, radius + sensitivity
 
 
 def _overridden(model, P, values: dict) -> np.ndarray:
@@ -116,7 +103,7 @@ def _block_roots(model, spec: dict, P):
         c = blocks[i]
         zero = np.all(c == 0, axis=0)  # coefficients zero in every set: exact zero roots
         k0 = int(np.argmin(zero)) if not zero.all() else c.shape[1]
-        z, est = _poly_roots(c[:, k0:])
+        z, est = _poly_roots(c[:, k0:], model)
         est = est / 2  # a frequency's relative error is half that of its z
         z = np.concatenate([np.zeros((N, k0), complex), z], axis=1) if "block" not in spec else z
         est = np.concatenate([np.full((N, k0), np.inf), est], axis=1) if "block" not in spec else est

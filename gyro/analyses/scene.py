@@ -54,7 +54,7 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
     for lv in cands:
         if pending.size == 0:
             break
-        trial = Trial(lv.name, np.zeros(N, np.int8), np.full(N, np.nan), np.full(N, None, object))
+        trial = Trial(lv.name, np.zeros(N, np.int8), np.full(N, np.nan))
         trials.append(trial)
         B = hierarchy.bounds(model, lv, question, P[pending], nq)
         missing = [names[j] for j in idx if not B.answered[j]]
@@ -65,7 +65,8 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
         beyond = B.bad
         hopeful = ~beyond & (pre <= tol)
         trial.code[pending[beyond]] = EDGE
-        trial.text[pending[beyond]] = B.invalid[beyond]
+        if beyond.any():
+            trial.say(pending[beyond], B.invalid[beyond])
         far = ~beyond & ~hopeful
         trial.code[pending[far]], trial.value[pending[far]] = APRIORI, pre[far]
         sub = np.flatnonzero(hopeful)
@@ -80,8 +81,10 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
         ok = ~failed & ~crossed & (worst <= tol)
         trial.value[ks] = worst
         trial.code[ks] = np.where(ok, ACCEPTED, np.where(failed, FAILED, np.where(crossed, QUESTION_EDGE, BOUND)))
-        trial.text[ks[failed]] = ans.failed[failed]
-        trial.text[ks[~failed & crossed]] = edge[~failed & crossed]
+        if failed.any():
+            trial.say(ks[failed], ans.failed[failed])
+        if (crossed & ~failed).any():
+            trial.say(ks[~failed & crossed], edge[~failed & crossed])
         level[ks[ok]] = lv.name
         bound[ks[ok]] = total[ok][:, idx]
         row[ks[ok]] = np.flatnonzero(ok)

@@ -40,6 +40,9 @@ def _ascending(f, e, g):
     """The answer in the question's order, ascending by frequency (NaN last; ties, as the
     real roots of a divergent set, in the spectrum's order): a spectrum comes ranked by
     |lambda|, which puts a divergent pair (frequency 0) above a slow oscillation."""
+    with np.errstate(invalid="ignore"):
+        if f.shape[1] < 2 or np.all(f[:, 1:] >= f[:, :-1]):  # sorted already (NaN compares false)
+            return f, e, g
     order = np.argsort(np.where(np.isnan(f), np.inf, f), axis=1, kind="stable")
     take = lambda a: np.take_along_axis(a, order, axis=1)  # noqa: E731
     return take(f), take(e), take(g)
@@ -205,15 +208,21 @@ def edges(model, ans: Answer, bound: np.ndarray, idx, answered) -> np.ndarray:
     want[list(idx)] = True
     relevant = want[:-1] | want[1:]
     touch &= relevant[None, :] & np.isfinite(bound[:, :-1]) & np.isfinite(bound[:, 1:])
-    for k in np.flatnonzero(touch.any(axis=1)):
-        j = int(np.flatnonzero(touch[k])[0])
-        out[k] = f"modes {j + 1} and {j + 2} within their bounds of each other (veering or a merged root)"
+    _say(out, touch, lambda j: f"modes {j + 1} and {j + 2} within their bounds of each other (veering or a merged root)")
     if want.any():
         lost = ~np.isfinite(bound) & answered[None, :]
-        for k in np.flatnonzero(lost.any(axis=1) & (out == "")):
-            j = int(np.flatnonzero(lost[k])[0])
-            out[k] = f"mode {j + 1} without a bound: its place among the others, and so every rank, is not decided"
+        lost &= ~touch.any(axis=1)[:, None]
+        _say(out, lost, lambda j: f"mode {j + 1} without a bound: its place among the others, and so every rank, is not decided")
     return out
+
+
+def _say(out: np.ndarray, flags: np.ndarray, text) -> None:
+    """out[k] = text(j) for each set k with a flag, j its first flagged column (the texts
+    made once per column, not per set: a million sets may cross an edge)."""
+    rows = np.flatnonzero(flags.any(axis=1))
+    if rows.size:
+        j = np.argmax(flags[rows], axis=1)
+        out[rows] = np.array([text(i) for i in range(flags.shape[1])], dtype=object)[j]
 
 
 def error(ans: Answer, ref: Answer) -> np.ndarray:

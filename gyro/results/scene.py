@@ -24,6 +24,12 @@ class Trial:
     text: np.ndarray | None = None  # object (sets,): edge name, failure, question edge
     missing: str = ""  # the requested quantities the level does not answer
 
+    def say(self, sets: np.ndarray, texts: np.ndarray) -> None:
+        """The text of an edge or failure at these sets (the array made at the first)."""
+        if self.text is None:
+            self.text = np.full(self.code.shape[0], None, object)
+        self.text[sets] = texts
+
     def reason(self, k: int, tol: float) -> str | None:
         c, v = int(self.code[k]), float(self.value[k])
         if c == NOT_REACHED:

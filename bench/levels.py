@@ -195,7 +195,8 @@ def speed(quick: bool) -> dict:
     n = 2000 if quick else 20000
     P = np.tile(TG.vector(), (n, 1))
     for lv in hierarchy.levels(TG):  # warm every compiled path
-        if lv.name != "linear_exact:reference" and not lv.name.endswith("polyroots"):
+        if (lv.answers_question("frequencies") and lv.name != "linear_exact:reference"
+                and not lv.name.endswith("polyroots")):
             F.answer(TG, lv, P[:2], {})
     t_exact = per_set(lambda: ladder.spectrum(TG, P, "default"), n)
     t_modes = per_set(lambda: select(TG, "frequencies", P, 1e-3, {"modes": [1, 2, 4]}), n)

@@ -259,12 +259,15 @@ def torsion_motion_figure(data: dict) -> str:
     spreads_ = sorted({p["spread"] for p in data["points"]})
     for i, name in enumerate(spreads_):
         pts = [p for p in data["points"] if p["spread"] == name]
-        e = np.array([p["error"] for p in pts]).ravel()
-        b = np.array([p["bound"] for p in pts]).ravel()
-        ok = (e > 0) & (b > 0)
+        e, b, bn = (np.array([p[k] for p in pts]).ravel() for k in ("error", "bound", "integrator_bound"))
+        shown = (e > 0) & (b > 0) & np.isfinite(b)
+        ok = shown & (e > 10 * bn)  # resolved: the integrator's estimate a tenth of the error or less
         ax.loglog(b[ok], e[ok], "o", ms=3, alpha=0.6, color=f"C{i}", label=name)
+        ax.loglog(b[shown & ~ok], e[shown & ~ok], "x", ms=3, alpha=0.4, color=f"C{i}")
+    ax.plot([], [], "kx", ms=3, label="not resolved (integrator's estimate > error/10)")
     allb = np.array([p["bound"] for p in data["points"]]).ravel()
-    lo, hi = allb[allb > 0].min(), allb.max()
+    allb = allb[np.isfinite(allb) & (allb > 0)]
+    lo, hi = allb.min(), allb.max()
     ax.loglog([lo, hi], [lo, hi], "k-", lw=1, label="error = bound")
     ax.loglog([lo, hi], [lo / 100, hi / 100], "k:", lw=1, label="bound 100x loose")
     ax.set_xlabel("linear_motion's bound (relative, per coordinate)")

@@ -197,6 +197,7 @@ def torsion_motion_map(quick: bool) -> dict:
     rotor tilted by 1 mrad (gamma1) spin, K0, Kp, K_gamma 0.1x..10x and latitude 0..89 deg.
     Per point each coordinate's error, the linear level's bound and the integrator's own,
     and each level's seconds."""
+    from gyro.analyses import torsion_motion as tm
     from gyro.questions import motion
 
     lin, full = hierarchy.get(TG, "linear_motion"), hierarchy.get(TG, "nonlinear_motion")
@@ -205,6 +206,9 @@ def torsion_motion_map(quick: bool) -> dict:
     for key, lo, hi in (("gamma_0", 1e-8, 1.0), ("beta_d0", 1e-6, 100.0), ("x1_0", 1e-10, 0.03)):
         for a in np.geomspace(lo, hi, n + 2):
             cases.append((f"amplitude {key}", key, float(a), {}, float(a)))
+    for key, amps in (("gamma_0", (0.2, 0.3, 0.45, 0.6)), ("beta_d0", (3.0, 10.0, 30.0))):
+        for a in amps:  # toward the cap of the linear bound (gyro.analyses.torsion_motion.CAP)
+            cases.append((f"near the cap {key}", key, a, {}, a))
     base = ("gamma1_0", 1e-3)
     for name in ("H", "K0", "Kp", "Kgamma"):
         for f in np.geomspace(0.1, 10.0, n if name == "H" else max(3, n // 2)):
@@ -221,8 +225,13 @@ def torsion_motion_map(quick: bool) -> dict:
         an = motion.answer(TG, full, P, opts)
         t2 = time.perf_counter()
         err = motion.error(al, an)[0]
+        # the linear estimate without its cap, over its own scale as the selector takes it (the
+        # cap's evidence)
+        mo = tm.Motion(dict(zip(TG.param_names, map(float, P[0]))), **opts["initial"])
+        uncapped = tm.linear_answer(mo, motion.times(opts), cap=np.inf)[1] / al.extra["scale"][0]
         points.append({"spread": spread, "x": x, "initial": {key: a}, "values": values,
                        "error": [float(v) for v in err], "bound": [float(v) for v in al.estimate[0]],
+                       "uncapped_bound": [float(v) for v in uncapped],
                        "integrator_bound": [float(v) for v in an.estimate[0]],
                        "seconds": {"linear_motion": t1 - t0, "nonlinear_motion": t2 - t1}})
         print(f"torsion motion {spread} {x:.3g}: error {np.max(err):.2e}, bound {np.max(al.estimate):.2e}, "
@@ -236,6 +245,10 @@ def torsion_motion_map(quick: bool) -> dict:
         ratio = np.where(resolved, e / b, np.nan)
         loose = np.where(resolved, b / e, np.nan)
     sec = {k: [p["seconds"][k] for p in points] for k in ("linear_motion", "nonlinear_motion")}
+    bu = np.array([p["uncapped_bound"] for p in points])
+    order = np.argsort(bu.max(axis=1))
+    cap = [{"uncapped_bound": float(bu[k].max()), "error_over_uncapped_bound": float(np.max(e[k] / bu[k]))}
+           for k in order if bu[k].max() > 0.01 and np.isfinite(bu[k].max())]
     return {"horizon_s": TM_HORIZON, "points": points,
             "held": bool(np.all(e <= b + bn)),  # every point: the error within both levels' bounds
             "max_error_over_bound_resolved": float(np.nanmax(ratio)),
@@ -244,6 +257,7 @@ def torsion_motion_map(quick: bool) -> dict:
             "bound_infinite_points": int(np.sum(~np.isfinite(b).all(axis=1))),
             "median_bound_over_error_per_coordinate": [float(np.nanmedian(c)) for c in loose.T],
             "error_range": [float(np.min(e.max(axis=1))), float(np.max(e.max(axis=1)))],
+            "cap": tm.CAP, "toward_the_cap": cap,
             "seconds_median": {k: float(np.median(v)) for k, v in sec.items()},
             "seconds_range": {k: [float(min(v)), float(max(v))] for k, v in sec.items()},
             "declared": {k: hierarchy.get(TG, k).cost for k in sec}}

@@ -204,22 +204,30 @@ def _group_max(v: np.ndarray) -> np.ndarray:
     return out
 
 
+def linear_answer(motion: Motion, t, cap: float = CAP):
+    """The linear level's answer: q0 + x_L at the times t (times, n) and its estimate, FACTOR
+    times the correction's largest |e| over each coordinate's unit group plus the rounding,
+    infinite where its largest exceeds `cap` of the motion's largest excursion (the error
+    map measures the uncapped estimate with cap = inf)."""
+    S = motion.reduced
+    n = S.n
+    zL, e, per = linear_motion(motion, t)
+    est = FACTOR * _group_max(np.max(np.abs(e), axis=0))[:n]
+    est += ROUNDING * np.finfo(float).eps * per * (len(t) - 1) * np.max(np.abs(zL[:, :n]))
+    excursion = np.max(np.sqrt(np.sum((zL[:, :n] - zL[:1, :n]) ** 2, axis=1)))
+    if not np.max(est) <= cap * excursion:  # beyond the iteration's reach: no bound
+        est = np.full(n, np.inf)
+    return S.q_ref[S.ri] + zL[:, :n], est
+
+
 def motion_answer(motion: Motion, t, method: str = "linear", rtol: float = 1e-9):
     """The `motion` question's evaluator (gyro/questions/motion.py): the reduced coordinates
     q0 + x at the times t (times, 10) and an estimate of each one's largest absolute error
     over t (m, rad)."""
     t = np.asarray(t, float)
-    S = motion.reduced
-    qe = S.q_ref[S.ri]
-    n = S.n
+    n = motion.reduced.n
     if method == "linear":
-        zL, e1, per = linear_motion(motion, t)
-        est = FACTOR * _group_max(np.max(np.abs(e1), axis=0))[:n]
-        est += ROUNDING * np.finfo(float).eps * per * (t.size - 1) * np.max(np.abs(zL[:, :n]))
-        excursion = np.max(np.sqrt(np.sum((zL[:, :n] - zL[:1, :n]) ** 2, axis=1)))
-        if not np.max(est) <= CAP * excursion:  # beyond the iteration's reach: no bound
-            est = np.full(n, np.inf)
-        return qe + zL[:, :n], est
+        return linear_answer(motion, t)
     from gyro import ode
 
     zL = linear_motion(motion, t)[0]

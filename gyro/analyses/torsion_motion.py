@@ -54,15 +54,16 @@ for _c in REDUCED:
                           f"{_WHAT[_c]} at t = 0, off its equilibrium value")
     INITIAL[f"{_c}_d0"] = (_UNIT[_c] + "/s", 0.0, f"the rate of {_WHAT[_c]} at t = 0")
 
-FACTOR = 2.0  # the bound over the correction: measured error/bound 0.50 at small amplitudes (bench)
+FACTOR = 2.0  # the bound over the correction: measured error/bound 0.50..0.55 below the cap (bench)
 # the largest estimate, over the motion's largest excursion (the question's scale), for which
-# it is a bound: measured error/bound <= 0.62 up to 0.31, 1.0 at 0.84, 2.0 at 1.3 (docs/hierarchy.md)
+# it is a bound: measured error over it 0.50..0.55 up to 0.15, 0.62 at 0.30, 0.77 at 0.58,
+# 1.0 at 0.84, 2.0 at 1.3 (bench/results/levels.json 'toward_the_cap', docs/hierarchy.md)
 CAP = 0.25
 ROUNDING = 4.0  # the exponential's rounding per step, in eps of the largest |z_L|
 CORRECTIONS = 2  # Picard steps: the second holds every term of third order (docs/hierarchy.md)
-FINE = 32
-FINER = 1e-2  # the second run's tolerance, of the first's
-FLOOR = 100.0  # the integrator's absolute tolerance, at least this many eps of the equilibrium  # samples per shortest period 2 pi/(2 omega_max) of the remainder's quadratic terms
+FINE = 32  # samples per shortest period 2 pi/(2 omega_max) of the remainder's quadratic terms
+FINER = 1e-2  # the integrator's second run's tolerance, of the first's
+FLOOR = 100.0  # the integrator's absolute tolerance, at least this many eps of the equilibrium
 
 
 class Motion:

@@ -193,7 +193,8 @@ def gimbal_map(quick: bool) -> dict:
 def torsion_motion_map(quick: bool) -> dict:
     """The torsion gyrocompass's linear motion against the integrated full equations over a
     horizon of TM_HORIZON s: the perturbation's amplitude (the casing's tilt gamma, its tilt
-    rate beta', the rotor's shift x1) from tiny to where the linearisation fails, and at the
+    rate beta' about the other axis, the rotor's shift x1) from tiny to where the
+    linearisation fails (and points toward the linear bound's cap), and at the
     rotor tilted by 1 mrad (gamma1) spin, K0, Kp, K_gamma 0.1x..10x and latitude 0..89 deg.
     Per point each coordinate's error, the linear level's bound and the integrator's own,
     and each level's seconds."""

@@ -5,7 +5,9 @@ and the figure of the level the selector picks along a sweep.
 `python -m bench.levels` (one core): writes bench/results/levels.json, one error-map
 figure per approximate level (levels_error_<level>.png: measured error against its bound)
 and one scene figure per model with a hierarchy (scene_<model>.png, its data in
-scenes.json). `--quick` for a smaller run; `--scenes [MODEL ...]` for the scene figures alone.
+scenes.json). `--quick` for a smaller run; `--scenes [MODEL ...]` for the scene figures alone;
+`--torsion-motion` for the torsion gyrocompass's motion map alone (levels.json
+'torsion_motion_map', levels_error_linear_motion.png).
 
 Spreads (torsion gyrocompass, each about the paper example): spin H, the bearing
 stiffnesses K0, Kp, K_gamma one at a time 0.1x..10x, latitude 0..89 deg, delta_b from 0
@@ -41,6 +43,7 @@ APPROXIMATE = ("formulas", "quartic", "decoupled", "linear_paper", "linear_exact
 GOALS = {"modes_1e-3_speedup": 100.0, "all_1e-3_speedup": 3.0, "tol_1e-9_slowdown": 1.2,
          "million_sets_1e-3_s": 60.0, "selector_overhead": 0.10}
 TOLS = (1e-2, 1e-5, 1e-9)
+TM_HORIZON = 0.05  # s: the torsion gyrocompass's motion map (some 30 periods of its fastest nutation)
 
 
 def _ix(name):
@@ -186,6 +189,113 @@ def gimbal_map(quick: bool) -> dict:
                         "integrator_bound": [float(x) for x in ref_bound[0]],
                         "held": bool(np.all(err <= bound + ref_bound))})
     return {"closed_form vs integrated:DOP853": out}
+
+
+def torsion_motion_map(quick: bool) -> dict:
+    """The torsion gyrocompass's linear motion against the integrated full equations over a
+    horizon of TM_HORIZON s: the perturbation's amplitude (the casing's tilt gamma, its tilt
+    rate beta' about the other axis, the rotor's shift x1) from tiny to where the
+    linearisation fails (and points toward the linear bound's cap), and at the
+    rotor tilted by 1 mrad (gamma1) spin, K0, Kp, K_gamma 0.1x..10x and latitude 0..89 deg.
+    Per point each coordinate's error, the linear level's bound and the integrator's own,
+    and each level's seconds."""
+    from gyro.analyses import torsion_motion as tm
+    from gyro.questions import motion
+
+    lin, full = hierarchy.get(TG, "linear_motion"), hierarchy.get(TG, "nonlinear_motion")
+    n = 3 if quick else 7
+    cases = []
+    for key, lo, hi in (("gamma_0", 1e-8, 1.0), ("beta_d0", 1e-6, 100.0), ("x1_0", 1e-10, 0.03)):
+        for a in np.geomspace(lo, hi, n + 2):
+            cases.append((f"amplitude {key}", key, float(a), {}, float(a)))
+    for key, amps in (("gamma_0", (0.2, 0.3, 0.45, 0.6)), ("beta_d0", (3.0, 10.0, 30.0))):
+        for a in amps:  # toward the cap of the linear bound (gyro.analyses.torsion_motion.CAP)
+            cases.append((f"near the cap {key}", key, a, {}, a))
+    base = ("gamma1_0", 1e-3)
+    for name in ("H", "K0", "Kp", "Kgamma"):
+        for f in np.geomspace(0.1, 10.0, n if name == "H" else max(3, n // 2)):
+            cases.append((f"{name} 0.1x..10x", *base, {name: float(f * TG.defaults[name])}, float(f)))
+    for phi in np.linspace(0.0, 89.0, max(3, n // 2)):
+        cases.append(("latitude 0..89 deg", *base, {"phi": float(phi)}, float(phi)))
+    points = []
+    for spread, key, a, values, x in cases:
+        opts = {"horizon": TM_HORIZON, "initial": {"gamma1_0": 0.0, key: a}}
+        P = TG.vector(values)[None, :]
+        t0 = time.perf_counter()
+        al = motion.answer(TG, lin, P, opts)
+        t1 = time.perf_counter()
+        an = motion.answer(TG, full, P, opts)
+        t2 = time.perf_counter()
+        err = motion.error(al, an)[0]
+        # the linear estimate without its cap, over its own scale as the selector takes it (the
+        # cap's evidence)
+        mo = tm.Motion(dict(zip(TG.param_names, map(float, P[0]))), **opts["initial"])
+        uncapped = tm.linear_answer(mo, motion.times(opts), cap=np.inf)[1] / al.extra["scale"][0]
+        points.append({"spread": spread, "x": x, "initial": {key: a}, "values": values,
+                       "error": [float(v) for v in err], "bound": [float(v) for v in al.estimate[0]],
+                       "uncapped_bound": [float(v) for v in uncapped],
+                       "integrator_bound": [float(v) for v in an.estimate[0]],
+                       "seconds": {"linear_motion": t1 - t0, "nonlinear_motion": t2 - t1}})
+        print(f"torsion motion {spread} {x:.3g}: error {np.max(err):.2e}, bound {np.max(al.estimate):.2e}, "
+              f"integrator {np.max(an.estimate):.2e}; {t1 - t0:.2f} s, {t2 - t1:.1f} s", flush=True)
+    e = np.array([p["error"] for p in points])
+    b = np.array([p["bound"] for p in points])
+    bn = np.array([p["integrator_bound"] for p in points])
+    # where the integrator's own estimate is a tenth of the error or less, and the bound finite
+    resolved = (e > 10 * bn) & np.isfinite(b)
+    with np.errstate(all="ignore"):
+        ratio = np.where(resolved, e / b, np.nan)
+        loose = np.where(resolved, b / e, np.nan)
+    sec = {k: [p["seconds"][k] for p in points] for k in ("linear_motion", "nonlinear_motion")}
+    bu = np.array([p["uncapped_bound"] for p in points])
+    order = np.argsort(bu.max(axis=1))
+    cap = [{"uncapped_bound": float(bu[k].max()), "error_over_uncapped_bound": float(np.max(e[k] / bu[k]))}
+           for k in order if bu[k].max() > 0.01 and np.isfinite(bu[k].max())]
+    return {"horizon_s": TM_HORIZON, "points": points,
+            "held": bool(np.all(e <= b + bn)),  # every point: the error within both levels' bounds
+            "max_error_over_bound_resolved": float(np.nanmax(ratio)),
+            "min_error_over_bound_resolved_worst_coordinate": float(np.nanmin(np.nanmax(ratio[resolved.any(axis=1)],
+                                                                                        axis=1))),
+            "bound_infinite_points": int(np.sum(~np.isfinite(b).all(axis=1))),
+            "median_bound_over_error_per_coordinate": [float(np.nanmedian(c)) for c in loose.T],
+            "error_range": [float(np.min(e.max(axis=1))), float(np.max(e.max(axis=1)))],
+            "cap": tm.CAP, "toward_the_cap": cap,
+            "seconds_median": {k: float(np.median(v)) for k, v in sec.items()},
+            "seconds_range": {k: [float(min(v)), float(max(v))] for k, v in sec.items()},
+            "declared": {k: hierarchy.get(TG, k).cost for k in sec}}
+
+
+def torsion_motion_figure(data: dict) -> str:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 4.8))
+    spreads_ = sorted({p["spread"] for p in data["points"]})
+    for i, name in enumerate(spreads_):
+        pts = [p for p in data["points"] if p["spread"] == name]
+        e, b, bn = (np.array([p[k] for p in pts]).ravel() for k in ("error", "bound", "integrator_bound"))
+        shown = (e > 0) & (b > 0) & np.isfinite(b)
+        ok = shown & (e > 10 * bn)  # resolved: the integrator's estimate a tenth of the error or less
+        ax.loglog(b[ok], e[ok], "o", ms=3, alpha=0.6, color=f"C{i}", label=name)
+        ax.loglog(b[shown & ~ok], e[shown & ~ok], "x", ms=3, alpha=0.4, color=f"C{i}")
+    ax.plot([], [], "kx", ms=3, label="not resolved (integrator's estimate > error/10)")
+    allb = np.array([p["bound"] for p in data["points"]]).ravel()
+    allb = allb[np.isfinite(allb) & (allb > 0)]
+    lo, hi = allb.min(), allb.max()
+    ax.loglog([lo, hi], [lo, hi], "k-", lw=1, label="error = bound")
+    ax.loglog([lo, hi], [lo / 100, hi / 100], "k:", lw=1, label="bound 100x loose")
+    ax.set_xlabel("linear_motion's bound (relative, per coordinate)")
+    ax.set_ylabel("its error against nonlinear_motion")
+    ax.set_title(f"torsion_gyrocompass, motion over {data['horizon_s']} s: linear_motion\n"
+                 "(the ten reduced coordinates of each point)", fontsize=9)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    path = RESULTS / "levels_error_linear_motion.png"
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path.name
 
 
 # ------------------------------------------------------------------ speed goals
@@ -471,7 +581,16 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--scenes", nargs="*", metavar="MODEL",
                     help="only the scene figures (of these models; all without a name): scenes.json")
+    ap.add_argument("--torsion-motion", action="store_true",
+                    help="only the torsion gyrocompass's motion map (levels.json 'torsion_motion_map')")
     args = ap.parse_args(argv)
+    if args.torsion_motion:
+        path = RESULTS / "levels.json"
+        out = json.loads(path.read_text()) if path.exists() else {}
+        out["torsion_motion_map"] = torsion_motion_map(args.quick)
+        out["torsion_motion_map"]["figure"] = torsion_motion_figure(out["torsion_motion_map"])
+        path.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
+        return 0
     if args.scenes is not None:
         scenes(args.quick, args.scenes or None)
         return 0
@@ -483,6 +602,8 @@ def main(argv=None) -> int:
     stats, samples = error_maps(args.quick)
     out["error_maps"] = stats
     out["gimbal_error_map"] = gimbal_map(args.quick)
+    out["torsion_motion_map"] = torsion_motion_map(args.quick)
+    out["torsion_motion_map"]["figure"] = torsion_motion_figure(out["torsion_motion_map"])
     print(f"error maps: {time.perf_counter() - t0:.0f} s", flush=True)
     out["rungs"] = rungs(args.quick)
     out["figures"] = error_figures(samples)

@@ -135,3 +135,15 @@ def numpy_variational(model: Model, P, inputs=None):
         return np.concatenate([np.asarray(yd).ravel(), np.asarray(phid).ravel(order="F")])
 
     return fun, n
+
+
+def two_tolerances(run, rtol: float, finer: float = 1e-2):
+    """An integrated answer and its error estimate by two tolerances (the `motion` question's
+    integrated levels): run(r) -> the answer (times, columns) at relative tolerance r; the
+    answer is the run at rtol * finer, the estimate per column twice its largest difference
+    from the run at rtol: an estimate of the coarser run's global error that bounds the
+    finer one's where the error falls with the tolerance (not near a separatrix:
+    docs/gimbal.md)."""
+    q1 = run(rtol)
+    q2 = run(rtol * finer)
+    return q2, 2 * np.max(np.abs(q1 - q2), axis=0)

@@ -199,27 +199,22 @@ def _spin_free_rate_jacobian():
     return _RATE_JACOBIAN["f"]
 
 
-class _Periodic:
-    """What the periodic responses to one harmonic share: the set P (and its values), the
-    equilibrium qe, the forcing frequency w = k omega_c and period T, the linear response
-    X_lin, the coordinates (11) and the reduced ones' indices ri (10), gamma3's index k3, the
-    equilibrium as all 11 coordinates q_ref; `state(x, xd)` the full state (q, q') of the
-    reduced coordinates' displacements x and rates xd about it, gamma3's rate from the
-    integral C r2 = H."""
+class ReducedState:
+    """The full 11-coordinate state about the relative equilibrium of one set: the set P (and
+    its values), the equilibrium qe, the coordinates (11) and the reduced ones' indices ri
+    (10), gamma3's index k3, the equilibrium as all 11 coordinates q_ref; `state(x, xd)` the
+    full state (q, q') of the reduced coordinates' displacements x and rates xd about it,
+    gamma3's rate from the integral C r2 = H (the forced response's and the free motion's,
+    gyro.analyses.torsion_motion)."""
 
-    def __init__(self, model: Model, values: dict, harmonic):
+    def __init__(self, model: Model, values: dict):
         from gyro.equilibrium import equilibrium
 
         _check_model(model)
-        s, k, a, phi = harmonic
+        self.model = model
         self.P = model.vector(values)
         self.values = model.parameters(values)
         self.qe = equilibrium(model, self.P)
-        self.w = k * float(spin_rate(model, self.P[None], self.qe[None])[0])
-        self.T = 2 * np.pi / self.w
-        u = np.zeros(3, complex)
-        u[s - 1] = -1j * a * np.exp(1j * phi)
-        self.X_lin = harmonic_response(model, self.P, self.w, u, qe=self.qe[None]).X[0]
         self.coords = model.meta["coordinates"]
         self.ri = np.array([self.coords.index(c) for c in model.meta["reduced"]])
         self.nq, self.n = len(self.coords), len(self.ri)
@@ -228,14 +223,21 @@ class _Periodic:
         for name, v in zip(model.meta["equilibrium_coordinates"], self.qe):
             self.q_ref[self.coords.index(name)] = v
 
-    def state(self, x, xd) -> np.ndarray:
-        q = self.q_ref.copy()
-        q[self.ri] += x
-        qd = np.zeros(self.nq)
-        qd[self.ri] = xd
+    def state(self, x, xd, lib=np):
+        """The full state (q, q') of reduced displacements x and rates xd; with lib = casadi,
+        of symbols (an SX column)."""
+        if lib is np:
+            q = self.q_ref.copy()
+            q[self.ri] += x
+            qd = np.zeros(self.nq)
+            qd[self.ri] = xd
+        else:
+            q, qd = list(self.q_ref), [0.0] * self.nq
+            for j, i in enumerate(self.ri):
+                q[i], qd[i] = q[i] + x[j], xd[j]
         g, gd = dict(zip(self.coords, q)), dict(zip(self.coords, qd))
-        qd[self.k3] = self.values["H"] / self.values["C"] - _spin_free_rate(self.values, g, gd)
-        return np.concatenate([q, qd])
+        qd[self.k3] = self.values["H"] / self.values["C"] - _spin_free_rate(self.values, g, gd, lib)
+        return np.concatenate([q, qd]) if lib is np else lib.vertcat(*q, *qd)
 
     def state_jacobian(self, Y: np.ndarray) -> np.ndarray:
         """d state / d (x, xd) at full states Y (2 nq, N): (N, 2 nq, 2 n), the identity on the
@@ -251,6 +253,20 @@ class _Periodic:
         dY[:, nq + self.k3, red] = -dr[:, :5]
         dY[:, nq + self.k3, [n + i for i in red]] = -dr[:, 5:]
         return dY
+
+
+class _Periodic(ReducedState):
+    """What the periodic responses to one harmonic share: ReducedState's, the forcing
+    frequency w = k omega_c and period T, and the linear response X_lin."""
+
+    def __init__(self, model: Model, values: dict, harmonic):
+        super().__init__(model, values)
+        s, k, a, phi = harmonic
+        self.w = k * float(spin_rate(model, self.P[None], self.qe[None])[0])
+        self.T = 2 * np.pi / self.w
+        u = np.zeros(3, complex)
+        u[s - 1] = -1j * a * np.exp(1j * phi)
+        self.X_lin = harmonic_response(model, self.P, self.w, u, qe=self.qe[None]).X[0]
 
 
 def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12, max_newton: int = 12,

@@ -664,6 +664,6 @@ def motion_answer(motion: Motion, t, method: str = "closed_form", rtol: float = 
         n = (t[-1] - t[0]) / cf.period if math.isfinite(cf.period) else math.inf
         est = eps * (16 * (1 + n) + 4 / math.sqrt(max(cf.m1, 1e-300)))
         return q, np.full(3, est * max(1.0, float(np.max(np.abs(q)))))
-    q1, _ = integrate(motion, t, method, rtol, rtol * 1e-2, budget_s=BUDGET_SECONDS)
-    q2, _ = integrate(motion, t, method, rtol * 1e-2, rtol * 1e-4, budget_s=BUDGET_SECONDS)
-    return q2, 2 * np.max(np.abs(q1 - q2), axis=0)
+    from gyro import ode
+
+    return ode.two_tolerances(lambda r: integrate(motion, t, method, r, r * 1e-2, budget_s=BUDGET_SECONDS)[0], rtol)

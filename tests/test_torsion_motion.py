@@ -136,6 +136,19 @@ def test_the_selector_takes_the_linear_motion_small_and_the_integration_large(tg
     assert s.tried(0)[0][0] == "linear_motion" and "bound" in s.tried(0)[0][1]
 
 
+def test_a_batch_with_initial_conditions_per_set_goes_up_set_by_set(tg):
+    """Two sets in one batch, the casing tilted by 1e-3 and by 0.2 rad: the first taken by the
+    linear motion, the second going up with its own initial condition (the options were
+    passed whole to the next level, whose sets are fewer: a broadcast error)."""
+    P = tg.vector()[None, :].repeat(2, axis=0)
+    opts = {"horizon": HORIZON, "points": 41,
+            "initial": {"gamma1_0": 0.0, "gamma_0": np.array([1e-3, 0.2])}}
+    s = select(tg, "motion", P, 1e-3, opts)
+    assert list(s.level) == ["linear_motion", "nonlinear_motion"]
+    gamma = s.document(1)["gamma"]
+    assert gamma[0] == pytest.approx(0.2, rel=1e-12)  # the second set's own start
+
+
 def test_scene_answers_a_motion_and_refuses_what_no_level_promises():
     rc, out, err = run_cli("scene", TG, "motion", "--tol", "1e-3", "--horizon", "0.01", "--set", "gamma1_0=1e-4",
                            "--json")

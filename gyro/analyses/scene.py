@@ -73,7 +73,7 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
         if sub.size == 0:
             continue
         ks = pending[sub]
-        ans = q.answer(model, lv, P[ks], opts)
+        ans = q.answer(model, lv, P[ks], q.subset(opts, ks, N) if hasattr(q, "subset") else opts)
         total = hierarchy.Bounds(B.apriori[sub], B.estimate, B.invalid[sub], B.answered, B.bad[sub]).total(ans.estimate)
         edge = q.edges(model, ans, total, idx, B.answered)
         worst = total[:, idx].max(axis=1) if idx else np.zeros(sub.size)

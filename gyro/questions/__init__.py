@@ -15,6 +15,8 @@ A question module has NAME (the command line's name) and:
 - `error(answer, reference) -> (sets, quantities)`: the relative error against another
   level's answer (error maps);
 - `document(model, answer, k, idx) -> dict`: the question's JSON keys for set k.
+- optionally `subset(opts, rows, n) -> opts`: the options for the sets `rows` of a batch
+  of n, where an option is given per set (the motion's initial conditions);
 - optionally VALUES: the key of `document` holding the per-quantity answer, which the
   scene's table shows beside each quantity's bound.
 

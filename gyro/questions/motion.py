@@ -75,6 +75,17 @@ def times(opts) -> np.ndarray:
     return np.linspace(0.0, float(opts.get("horizon", DEFAULT_HORIZON)), int(opts.get("points", POINTS)))
 
 
+def subset(opts: dict, rows: np.ndarray, n: int) -> dict:
+    """The options for the sets `rows` of a batch of n: an initial condition given per set
+    (an array of n) taken at those rows, one given for all kept."""
+    init = opts.get("initial")
+    if not init:
+        return opts
+    out = dict(opts)
+    out["initial"] = {k: (np.asarray(v)[rows] if np.ndim(v) and np.shape(v)[0] == n else v) for k, v in init.items()}
+    return out
+
+
 def answer(model, level, P, opts) -> Answer:
     if level.evaluator.get("kind") != "trajectory":
         raise unknown_kind(NAME, level)

@@ -33,6 +33,7 @@ from gyro import ladder  # noqa: E402
 from gyro import levels as hierarchy  # noqa: E402
 from gyro import questions  # noqa: E402
 from gyro.analyses.scene import level_error, select  # noqa: E402
+from gyro.analyses.scene import rungs as scene_rungs  # noqa: E402
 from gyro.models import load  # noqa: E402
 from gyro.questions import frequencies as F  # noqa: E402
 
@@ -344,17 +345,15 @@ def speed(quick: bool) -> dict:
 
 def rungs(quick: bool) -> dict:
     """How far above the cheapest level that was enough the selector goes: per tolerance,
-    the sets whose chosen level is more than one rung (a level answering every frequency,
-    cheapest first) above the cheapest level whose measured error meets tol / margin, for
+    the sets whose chosen level is more than one rung (a level answering every frequency and
+    not dominated there, cheapest first: gyro.analyses.scene.rungs) above the cheapest level whose measured error meets tol / margin, for
     margins 1, 2 and 5 (tests/test_hierarchy.py holds margin 5 at no set)."""
     n = 100 if quick else 400
     P = joint(n, seed=12)
     ref = F.answer(TG, hierarchy.get(TG, "linear_exact:default"), P, {})
-    rungs_ = [lv for lv in hierarchy.levels(TG) if lv.answers_question("frequencies")
-              and all(hierarchy.bounds(TG, lv, "frequencies", P[:1], 10).answered)]
-    names = [lv.name for lv in rungs_]
-    err = {lv.name: F.error(F.answer(TG, lv, P, {}), ref) for lv in rungs_
-           if lv.cost <= hierarchy.get(TG, "linear_exact").cost}
+    names = scene_rungs(TG, "frequencies", P, until="linear_exact:default")
+    err = {n: F.error(F.answer(TG, hierarchy.get(TG, n), P, {}), ref) for n in names
+           if hierarchy.get(TG, n).cost <= hierarchy.get(TG, "linear_exact").cost}
     out = {"sets": n, "rungs": names, "tolerances": {}}
     for tol in (3e-2, 1e-3, 1e-4, 1e-6, 1e-9):
         sc = select(TG, "frequencies", P, tol)

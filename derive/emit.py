@@ -383,6 +383,35 @@ def _mode_select(functions: list[Function]) -> dict | None:
     return None
 
 
+# calls that are instructions of the compiler's SIMD (no -ffast-math needed to vectorise them)
+_VECTOR_CALLS = {"sqrt", "fabs", "fmin", "fmax"}
+
+
+def _lanes(fn: EmittedFunction) -> dict | None:
+    """The C statements of the mode formulas split for a loop over sets in structure of
+    arrays (templates/mode_select.c.j2): `pre`, the temporaries that call a function the
+    SIMD has no instruction for (cos of the latitude) and those they depend on, computed set
+    by set; `post`, the others, computed for all lanes at once. None where an output itself
+    makes such a call (the kernel then stays set by set)."""
+    names = {t for t, _ in fn.temps}
+    calls = lambda e: set(re.findall(r"\b([A-Za-z_]\w*)\s*\(", e)) - _VECTOR_CALLS  # noqa: E731
+    if any(calls(e) for o in fn.outputs for _, e in o.entries):
+        return None
+    deps = {t: set(re.findall(r"\b(t\d+)\b", e)) & names for t, e in fn.temps}
+    need, stack = set(), [t for t, e in fn.temps if calls(e)]
+    while stack:
+        t = stack.pop()
+        if t not in need:
+            need.add(t)
+            stack.extend(deps[t])
+    return {"pre": [(t, e) for t, e in fn.temps if t in need],
+            "post": [(t, e) for t, e in fn.temps if t not in need],
+            "inputs": [(sym, i) for inp in fn.inputs for i, sym in enumerate(inp.symbols)],
+            # every entry, zeros written out: a loop inside the lanes' loop would stop its SIMD
+            "outputs": {o.name: [(i, dict(o.entries).get(i, "0.0")) for i in range(o.rows * o.cols)]
+                        for o in fn.outputs}}
+
+
 def environment() -> jinja2.Environment:
     return jinja2.Environment(
         loader=jinja2.FileSystemLoader(str(TEMPLATES)),
@@ -414,6 +443,8 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
     common = dict(model=model.name, title=model.title, paper=model.source, source=source,
                   digest=digest, versions=tool_versions(), prefix=model.name, qep_n=_operator_dim(functions),
                   select=_mode_select(functions))
+    if common["select"]:
+        common["select"]["lanes"] = _lanes(next(f for f in emitted["c"] if f.name == "mode_formulas"))
     files = {
         "casadi_functions.py": ("casadi_functions.py.j2", emitted["casadi"]),
         "numpy_functions.py": ("numpy_functions.py.j2", emitted["numpy"]),

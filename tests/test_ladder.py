@@ -546,3 +546,23 @@ def test_cli_stability_map_log_axis(tmp_path):
              "--y", "H", "--y-range", "0", "10", "--y-log", "--out", str(bad), "--quiet")
     assert p.returncode == 2 and "--y-log" in p.stderr and len(p.stderr.strip().splitlines()) == 1
     assert not bad.exists()
+
+
+def test_the_formulas_in_lanes_are_the_set_by_set_formulas_to_the_last_bit():
+    """The compiled formulas run eight sets at a time in structure of arrays (templates/
+    mode_select.c.j2); over 1,003 joint sets (a short last block) and a set outside the
+    formulas' domain (K_gamma < 0: square roots of negatives), their frequencies and
+    estimates are those of the set-by-set generated function with the selection and sort
+    done in NumPy, bit for bit (NaN where NaN)."""
+    from bench.levels import joint
+    from gyro.methods.formulas import per_mode
+
+    P = joint(1003, seed=9)
+    P[17, MODEL.param_names.index("Kgamma")] *= -1.0
+    lanes = ladder.spectrum(MODEL, P, "formulas")
+    f, e = per_mode(MODEL, P)  # the set-by-set C of mode_formulas
+    order = np.argsort(f, axis=1, kind="stable")
+    f, e = np.take_along_axis(f, order, 1), np.take_along_axis(e, order, 1)
+    assert np.isnan(lanes.frequencies[17]).any()
+    np.testing.assert_array_equal(lanes.frequencies, f)
+    np.testing.assert_array_equal(lanes.error_estimate, e)

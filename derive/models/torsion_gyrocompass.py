@@ -556,6 +556,9 @@ def levels(F):
               {"kind": "spectrum", "method": "formulas"}, {"frequencies": Bound(estimate=True)},
               reference="linear_exact",
               doc="the paper's approximate formulas, corrected, with their derived estimates"),
+        # costs measured by bench/levels.py (one core, 20,000 sets): since the roots are proven
+        # Aberth roots in C, the paper operator's blocks cost less than the formulas with the
+        # quartic's roots (2.7-3.2 us against 4.1-4.8 us a set), so quartic comes after them
         Level("quartic", "gravity in the nutation modes (the g = 0 quartic (3.10) of J'' at u = 0), and what "
                          "decoupled neglects; the other modes by their formulas",
               {"kind": "formulas", "roots": {"function": "paper_charpoly", "block": 2, "set": {"u": 0.0, "g": 0.0},
@@ -564,19 +567,19 @@ def levels(F):
                                              "apriori": "bound_blocks"}},
               {"frequencies": Bound(estimate=True)},
               valid=blocks_edges,
-              cost=1.0e-5, reference="linear_exact",
+              cost=4.4e-6, reference="linear_exact",
               doc="the roots of the quartic (3.10) for the four nutation modes, with twice the first-order "
                   "gravity shift of each as its estimate; the other six modes by (3.2)-(3.9)"),
         Level("decoupled", "the Earth-rate coupling of the two blocks (eps1 = 0, (3.1)), and what (2.4) drops",
               {"kind": "charpoly", "function": "paper_charpoly", "set": {"u": 0.0}},
               {"frequencies": [None] + [Bound(blocks, estimate=True)] * (n - 1)},
               valid=blocks_edges,
-              cost=1.6e-5, reference="linear_exact",
+              cost=2.9e-6, reference="linear_exact",
               doc="the blocks J', J'' of (2.4) at u = 0: roots of their characteristic polynomials"),
         Level("linear_paper", "linearisation at q = 0 (offsets of (2.2)), u3 terms, u^2 terms, A u and I_i u against H",
               {"kind": "charpoly", "function": "paper_charpoly"}, {"frequencies": Bound(paper, estimate=True)},
               valid={"l2 != 0 (the sag's bound)": sp.Abs(l2)},
-              cost=2.0e-5, reference="linear_exact",
+              cost=3.0e-6, reference="linear_exact",
               doc="the paper's printed operator (2.4), corrected: roots of its blocks' characteristic polynomials"),
         Level("linear", "the full equations' terms of second and higher order in the amplitudes",
               # costs: medians over the bench's two ladders of amplitudes (bench/forced_nonlinear.py,

@@ -108,3 +108,32 @@ def level_error(model, question: str, level: str, against: str, P, opts: dict | 
     err[(ans.failed != "") | (ref.failed != "")] = np.nan
     B = hierarchy.bounds(model, a, question, P, nq)
     return err, B.total(ans.estimate)
+
+
+def rungs(model, question: str, P, opts: dict | None = None, until: str | None = None) -> list:
+    """The levels the selector can take for `question` on the sets P, cheapest first: those
+    that answer every requested quantity and are not dominated on P, a level being
+    dominated where a cheaper one's largest bound over the requested quantities is no
+    larger on every set (the quartic level behind the paper operator's blocks: its nutation
+    roots carry the blocks' bound and more). The rungs of the hierarchy's property tests;
+    `until` names the last level looked at (the costlier ones are not run)."""
+    opts = dict(opts or {})
+    q = questions.get(question)
+    P = as_batch(model, P)
+    idx = q.requested(model, opts)
+    nq = len(q.quantities(model, opts))
+    out, worst = [], []
+    for lv in hierarchy.levels(model):
+        if not lv.answers_question(question):
+            continue
+        B = hierarchy.bounds(model, lv, question, P, nq)
+        if not all(B.answered[j] for j in idx):
+            continue
+        w = B.total(q.answer(model, lv, P, opts).estimate)[:, idx].max(axis=1)
+        if any(np.all(v <= w) for v in worst):
+            continue
+        out.append(lv.name)
+        worst.append(w)
+        if lv.name == until:
+            break
+    return out

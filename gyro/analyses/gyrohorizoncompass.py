@@ -532,7 +532,10 @@ FIRST_STEP_FACTOR = 2.0  # the linear motion's estimate: this times its first co
 # where the first correction exceeds this fraction of the linear motion's largest excursion
 # (over the angles), one step does not resolve the linearisation's error and the estimate
 # is infinite (measured, bench/levels.py: the error stays below twice the first step up to
-# a ratio of 0.3; at 0.4 it reached 3.4 times it)
+# a ratio of 0.3; at 0.4 it reached 3.4 times it); and where it exceeds this fraction of a
+# radian: no tolerance below 1 on a scale of at least 1 rad needs more, and an unstable
+# linear motion that has grown to radians may cross beta = +-90 deg, where the angles (1.1)
+# are singular (the mass matrix of (1.5)-(1.6) is) and the remainder cannot be evaluated
 FIRST_STEP_SMALL = 0.1
 
 
@@ -594,13 +597,15 @@ def _rounding(A: np.ndarray, x: np.ndarray, t) -> np.ndarray:
 
 
 def first_correction(values: dict, ye: np.ndarray, A: np.ndarray, x: np.ndarray, t, rtol: float,
-                     budget_s: float | None = None) -> np.ndarray:
+                     budget_s: float | None = None, limit: float = math.inf) -> np.ndarray:
     """d(t) (times, 8): the response of the linearised equations to the remainder of
     (1.5)-(1.6) along the linear motion, d' = A d + f(ye + x) - A x, d(0) = 0 (gyro.ode.
     correction_rhs), integrated beside x' = A x from x(0) = x[0] by DOP853 at rtol; the
     absolute tolerance of each component is rtol/100 of its linear motion's largest size
     over the times t (of x: the linear motion at t) and of the largest such size squared
-    (of d: the remainder is of second order in x)."""
+    (of d: the remainder is of second order in x). The run stops where the largest of
+    the angles' d reaches `limit`; d is infinite from there on (on an unstable set whose
+    linear motion grows, the correction would grow with its square)."""
     from scipy.integrate import solve_ivp
 
     from gyro import ode
@@ -612,11 +617,17 @@ def first_correction(values: dict, ye: np.ndarray, A: np.ndarray, x: np.ndarray,
     fun = ode.correction_rhs(model(), model().vector(values), ye, A)
     max_s = math.inf if budget_s is None else budget_s
     rhs = ode.budgeted(fun, "the linear motion's first correction", t[-1], max_s, BUDGET_STEPS, IntegrationBudget)
+    def reached(_, z):
+        return limit - np.max(np.abs(z[8:12]))
+
+    reached.terminal = True
     sol = solve_ivp(rhs, (t[0], t[-1]), np.concatenate([x[0], np.zeros(8)]), method="DOP853", t_eval=t,
-                    rtol=rtol, atol=atol)
+                    rtol=rtol, atol=atol, events=reached)
     if not sol.success:
         raise FloatingPointError(f"the linear motion's first correction: {sol.message}")
-    return sol.y.T[:, 8:]
+    d = np.full((t.size, 8), np.inf)
+    d[:sol.y.shape[1]] = sol.y.T[:, 8:]
+    return d
 
 
 def motion_answer(motion: Motion, t, method: str = LINEAR, rtol: float = RTOL):
@@ -625,12 +636,13 @@ def motion_answer(motion: Motion, t, method: str = LINEAR, rtol: float = RTOL):
     relative equilibrium, and an estimate of each one's largest absolute error over t (rad).
 
     `linear`: the motion of the linearised equations, ye + e^{A t} x0, exact (expm). Its
-    estimate against the motion of (1.5)-(1.6): twice the largest first correction d
-    (`first_correction`, at rtol), the linear motion's error to second order in x0, plus
+    estimate against the motion of (1.5)-(1.6), the same for the four angles: twice the
+    largest first correction d over them (`first_correction`, at rtol; d is the linear
+    motion's error to second order in x0, per coordinate), plus
     the rounding (`_rounding`: two routes of expm compared) and that of ye + x. Measured (bench/levels.py, docs/hierarchy.md): the error is d to within
     its next order, so twice d bounds it where the first correction is small against the
     motion; where it exceeds FIRST_STEP_SMALL of the linear motion's largest excursion
-    the estimate is infinite (the selector goes on to an integrator).
+    (or of a radian) the estimate is infinite (the selector goes on to an integrator).
 
     An integrator of METHODS: the equations (1.5)-(1.6) integrated at rtol and rtol/100
     (gyro.ode.two_tolerances; within the command line's budget)."""
@@ -641,10 +653,15 @@ def motion_answer(motion: Motion, t, method: str = LINEAR, rtol: float = RTOL):
     if method == LINEAR:
         x = linear_motion(A, x0, t)
         rounding = _rounding(A, x, t)[:4]
-        d = first_correction(values, ye, A, x, t, rtol, BUDGET_SECONDS)
+        limit = FIRST_STEP_SMALL * min(float(np.max(np.abs(x[:, :4]))), 1.0)
+        d = first_correction(values, ye, A, x, t, rtol, BUDGET_SECONDS, limit)
         q = ye[:4] + x[:, :4]
-        step = np.max(np.abs(d[:, :4]), axis=0)
-        if not np.max(step) <= FIRST_STEP_SMALL * np.max(np.abs(x[:, :4])):
+        # the largest first step over the four angles (one unit): the next step carries a
+        # large correction of one angle into the others through the coupling (near zeta = 0,
+        # where alpha's restoring moment I (1 + theta) zeta^2 vanishes, alpha's step is 200 times
+        # the others', whose errors then reach 5 times their own steps)
+        step = float(np.max(np.abs(d[:, :4])))
+        if not step <= limit:
             return q, np.full(4, np.inf)  # the linearisation fails: its error is not one small step
         return q, FIRST_STEP_FACTOR * step + rounding + U * np.max(np.abs(q), axis=0)
     from gyro import ode

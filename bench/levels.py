@@ -293,6 +293,32 @@ def ghc_motion_map(quick: bool) -> tuple[dict, dict]:
     return {"summary": summary, "points": rows}, samples
 
 
+def ghc_motion_edge(quick: bool) -> list:
+    """The evidence for the linear level's edge: the Earth set over 10 s and the laboratory
+    set over 400 s at growing amplitudes, the largest first step over the angles against
+    the linear motion's excursion (step/x) and the largest error over twice that step
+    (beyond 1 the bound would be beaten)."""
+    import gyro.analyses.gyrohorizoncompass as ghc
+
+    m = load(GHC)
+    out = []
+    for base_name, base, horizon, amps in (("Earth", dict(zip(m.param_names, m.vector())), 10.0,
+                                            (0.1, 0.3, 0.4, 0.6) if quick else (0.1, 0.2, 0.3, 0.4, 0.5, 0.6)),
+                                           ("laboratory", GHC_LAB, 400.0, (0.03, 0.1) if quick else (0.03, 0.1, 0.3))):
+        t = np.linspace(0.0, horizon, 201)
+        ye, A = ghc.linearisation(base)
+        for a in amps:
+            mo = ghc.Motion(base, a, a, a, a)
+            x = ghc.linear_motion(A, mo.perturbation, t)
+            step = float(np.max(np.abs(ghc.first_correction(base, ye, A, x, t, 1e-6)[:, :4])))
+            q, _ = ghc.motion_answer(mo, t, "DOP853", 1e-10)
+            err = np.max(np.abs(ye[:4] + x[:, :4] - q), axis=0)
+            out.append({"base": base_name, "horizon": horizon, "a": a,
+                        "step_over_excursion": step / float(np.max(np.abs(x[:, :4]))),
+                        "max_error_over_twice_step": float(np.max(err)) / (2 * step)})
+    return out
+
+
 def ghc_motion_figure(samples: dict) -> str:
     """The linear motion level's measured error against its bound, one colour per spread."""
     import matplotlib
@@ -344,6 +370,7 @@ def ghc_motion(quick: bool, out: dict) -> dict:
     out.setdefault("costs", {}).update(ghc_motion_costs(quick))
     out["ghc_motion_error_map"], samples = ghc_motion_map(quick)
     out["ghc_motion_error_map"]["quick"] = quick
+    out["ghc_motion_error_map"]["edge"] = ghc_motion_edge(quick)
     out["ghc_motion_error_map"]["figure"] = ghc_motion_figure(samples)
     return out
 

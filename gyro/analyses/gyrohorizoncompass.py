@@ -531,8 +531,9 @@ LINEAR = "linear"  # motion_answer's method: the linearised equations about (3.1
 FIRST_STEP_FACTOR = 2.0  # the linear motion's estimate: this times its first correction
 # where the first correction exceeds this fraction of the linear motion's largest excursion
 # (over the angles), one step does not resolve the linearisation's error and the estimate
-# is infinite (measured, bench/levels.py: the error stays below twice the first step up to
-# a ratio of 0.3; at 0.4 it reached 3.4 times it); and where it exceeds this fraction of a
+# is infinite (measured, bench/levels.py `ghc_motion_edge`: the error stays below twice the
+# first step up to a ratio of 0.3, 0.64 of it there; at 0.4 it is 1.1 times it, at 0.6 3.7
+# times, the Earth set over 10 s); and where it exceeds this fraction of a
 # radian: no tolerance below 1 on a scale of at least 1 rad needs more, and an unstable
 # linear motion that has grown to radians may cross beta = +-90 deg, where the angles (1.1)
 # are singular (the mass matrix of (1.5)-(1.6) is) and the remainder cannot be evaluated
@@ -617,6 +618,7 @@ def first_correction(values: dict, ye: np.ndarray, A: np.ndarray, x: np.ndarray,
     fun = ode.correction_rhs(model(), model().vector(values), ye, A)
     max_s = math.inf if budget_s is None else budget_s
     rhs = ode.budgeted(fun, "the linear motion's first correction", t[-1], max_s, BUDGET_STEPS, IntegrationBudget)
+
     def reached(_, z):
         return limit - np.max(np.abs(z[8:12]))
 
@@ -638,11 +640,12 @@ def motion_answer(motion: Motion, t, method: str = LINEAR, rtol: float = RTOL):
     `linear`: the motion of the linearised equations, ye + e^{A t} x0, exact (expm). Its
     estimate against the motion of (1.5)-(1.6), the same for the four angles: twice the
     largest first correction d over them (`first_correction`, at rtol; d is the linear
-    motion's error to second order in x0, per coordinate), plus
-    the rounding (`_rounding`: two routes of expm compared) and that of ye + x. Measured (bench/levels.py, docs/hierarchy.md): the error is d to within
-    its next order, so twice d bounds it where the first correction is small against the
-    motion; where it exceeds FIRST_STEP_SMALL of the linear motion's largest excursion
-    (or of a radian) the estimate is infinite (the selector goes on to an integrator).
+    motion's error to second order in x0, per coordinate), plus the rounding (`_rounding`:
+    two routes of expm compared) and that of ye + x. Measured (bench/levels.py,
+    docs/hierarchy.md): the error is d to within its next order, so twice d bounds it
+    where the first correction is small against the motion; where it exceeds
+    FIRST_STEP_SMALL of the linear motion's largest excursion (or of a radian) the
+    estimate is infinite (the selector goes on to an integrator).
 
     An integrator of METHODS: the equations (1.5)-(1.6) integrated at rtol and rtol/100
     (gyro.ode.two_tolerances; within the command line's budget)."""

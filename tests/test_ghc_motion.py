@@ -138,6 +138,20 @@ def test_the_linear_bound_holds_on_held_out_sets(m, fL, fnu, fz, phi, loga, u, h
     assert np.all(err <= b + rb), (err, b)
 
 
+def test_an_unstable_linear_motion_grown_to_radians_ends_the_correction_at_the_edge():
+    """A joint draw of the map (unstable: a real pair +-0.36 1/s): the linear motion grows to
+    58 rad over 20 s and crosses beta = 90 deg, where (1.5)-(1.6) are singular; the first
+    correction stops where it reaches a tenth of a radian (it stalled there at t = 9.9 s
+    until the 25 s budget before) and the bound is infinite."""
+    v = dict(LAB, L=1.0898175348716335, nu=0.4373361881796883, zeta=0.7319958879293237, eta=0.298647299020574)
+    init = dict(zip(ANGLES + RATES, (0.01898099648780537, -0.04660870366845586, -0.027278051677344314,
+                                     0.0017402664645622718, 0.02298913434091618, 0.048953585825479505,
+                                     0.0185996849062146, -0.04150126746958118)))
+    assert ghc.stability(v).verdict == "unstable"
+    q, est = ghc.motion_answer(ghc.Motion(v, **init), np.linspace(0.0, 20.0, 201), "linear", 1e-6)
+    assert np.max(np.abs(q[:, 1] - q[0, 1])) > np.pi / 2 and np.all(np.isinf(est))
+
+
 def test_the_selector_takes_linear_for_small_and_an_integrator_for_large_perturbations(m):
     P = m.vector()[None, :]
     small = select(m, "motion", P, 1e-3, {"horizon": 0.5, "initial": {k: 1e-3 for k in ANGLES}})

@@ -5,7 +5,9 @@ and the figure of the level the selector picks along a sweep.
 `python -m bench.levels` (one core): writes bench/results/levels.json, one error-map
 figure per approximate level (levels_error_<level>.png: measured error against its bound)
 and one scene figure per model with a hierarchy (scene_<model>.png, its data in
-scenes.json). `--quick` for a smaller run; `--scenes [MODEL ...]` for the scene figures alone.
+scenes.json). `--quick` for a smaller run; `--scenes [MODEL ...]` for the scene figures alone;
+`--ghc-motion` for the gyrohorizoncompass's motion levels alone (their costs, the linear
+level's error map and edge, levels_error_gyrohorizoncompass_linear.png), into levels.json.
 
 Spreads (torsion gyrocompass, each about the paper example): spin H, the bearing
 stiffnesses K0, Kp, K_gamma one at a time 0.1x..10x, latitude 0..89 deg, delta_b from 0

@@ -8,6 +8,8 @@ and one scene figure per model with a hierarchy (scene_<model>.png, its data in
 scenes.json). `--quick` for a smaller run; `--scenes [MODEL ...]` for the scene figures alone;
 `--torsion-motion` for the torsion gyrocompass's motion map alone (levels.json
 'torsion_motion_map', levels_error_linear_motion.png).
+`--ghc-motion` for the gyrohorizoncompass's motion levels alone (their costs, the linear
+level's error map and edge, levels_error_gyrohorizoncompass_linear.png), into levels.json.
 
 Spreads (torsion gyrocompass, each about the paper example): spin H, the bearing
 stiffnesses K0, Kp, K_gamma one at a time 0.1x..10x, latitude 0..89 deg, delta_b from 0
@@ -299,6 +301,194 @@ def torsion_motion_figure(data: dict) -> str:
     return path.name
 
 
+# ------------------------------------------------------------------ the gyrohorizoncompass's motions
+
+GHC = "gyrohorizoncompass"
+GHC_LAB = {"A": 1.0, "B": 1.05, "C": 1.1, "J": 1.0, "L": 0.5, "I": 1.0, "nu": 1.0, "zeta": 0.5, "eta": 0.2,
+           "lam": 1.05}  # docs/gyrohorizoncompass.md's laboratory set (modes 0.35..1.0 rad/s)
+GHC_ANGLES = ("alpha0", "beta0", "gamma0", "delta_epsilon0")
+GHC_RATES = ("dalpha0", "dbeta0", "dgamma0", "depsilon0")
+
+
+def ghc_motion_cases(quick: bool) -> list:
+    """(spread, base, x, P (1, parameters), options) per point of the linear motion level's
+    error map: the perturbation's amplitude a (the four angles at a, at rest) from 1e-6
+    rad to where the linearisation fails, on the Earth set over 2 s (the nutation modes,
+    104 and 220 rad/s; the Schuler-like ones hardly move) and on the laboratory set over
+    20 s (about one period of its slowest mode); and at a = 1e-2 rad the laboratory set's
+    spin L, Schuler frequency nu, speed zeta = v/R each 0.1x..10x, the latitude of the
+    Darboux rate (zeta, eta) = w (cos phi, sin phi) 0..89 deg, and the Earth set's L and
+    zeta 0.1x..10x (where the equilibrium (3.1) exists: I lambda zeta/2L < 1); and a joint
+    random spread of the laboratory set's parameters and the perturbation's direction."""
+    m = load(GHC)
+    names = m.param_names
+    earth = dict(zip(names, m.vector()))
+    na = 6 if quick else 13
+    npar = 5 if quick else 9
+    out = []
+
+    def add(spread, base_name, base, x, horizon, a=1e-2, init=None, **change):
+        v = dict(base)
+        v.update(change)
+        init = {k: a for k in GHC_ANGLES} if init is None else init
+        out.append((spread, base_name, float(x), m.vector(v)[None, :], {"horizon": horizon, "initial": init}))
+
+    for base_name, base, horizon in (("Earth", earth, 2.0), ("laboratory", GHC_LAB, 20.0)):
+        for a in np.geomspace(1e-6, 0.5, na):
+            add("amplitude a (rad)", base_name, base, a, horizon, a=a)
+    f = np.geomspace(0.1, 10.0, npar)
+    for k in f:
+        for name in ("L", "nu", "zeta"):
+            add(f"{name} 0.1x..10x", "laboratory", GHC_LAB, k, 20.0, **{name: GHC_LAB[name] * k})
+    w = np.hypot(GHC_LAB["zeta"], GHC_LAB["eta"])
+    for phi in np.linspace(0.0, 89.0, npar):
+        add("latitude 0..89 deg", "laboratory", GHC_LAB, phi, 20.0,
+            zeta=w * np.cos(np.radians(phi)), eta=w * np.sin(np.radians(phi)))
+    for k in f:
+        for name in ("L", "zeta"):
+            add(f"{name} 0.1x..10x", "Earth", earth, k, 2.0, **{name: earth[name] * k})
+    # jointly: L, nu, zeta 0.3x..3x, the latitude, and a perturbation of angles and rates in
+    # a random direction, amplitude 1e-5..0.1 (rad, rad/s)
+    rng = np.random.default_rng(5)
+    for _ in range(8 if quick else 24):
+        fL, fn, fz = np.exp(rng.uniform(np.log(0.3), np.log(3.0), 3))
+        phi = np.radians(rng.uniform(0.0, 89.0))
+        u = rng.normal(size=8)
+        a = float(np.exp(rng.uniform(np.log(1e-5), np.log(0.1))))
+        add("joint random", "laboratory", GHC_LAB, a, 20.0,
+            init=dict(zip(GHC_ANGLES + GHC_RATES, (a * u / np.max(np.abs(u))).tolist())),
+            L=GHC_LAB["L"] * fL, nu=GHC_LAB["nu"] * fn, zeta=w * fz * np.cos(phi), eta=w * fz * np.sin(phi))
+    return out
+
+
+def ghc_motion_map(quick: bool) -> tuple[dict, dict]:
+    """The linear motion level against integrated:DOP853 over `ghc_motion_cases`: per point
+    and coordinate the measured relative error, the linear bound and the reference's own
+    bound (an error counts as beaten where it exceeds the sum of both: at tiny amplitudes
+    the reference's truncation is of the size of the linear error)."""
+    from gyro.questions import motion
+
+    m = load(GHC)
+    lin, ref = hierarchy.get(m, "linear"), hierarchy.get(m, "integrated:DOP853")
+    rows, samples = [], {}
+    for spread, base, x, P, opts in ghc_motion_cases(quick):
+        t0 = time.perf_counter()
+        a = motion.answer(m, lin, P, opts)
+        t1 = time.perf_counter()
+        r = motion.answer(m, ref, P, opts)
+        t2 = time.perf_counter()
+        err = motion.error(a, r)[0]
+        bound = hierarchy.bounds(m, lin, "motion", P, err.size).total(a.estimate)[0]
+        rbound = hierarchy.bounds(m, ref, "motion", P, err.size).total(r.estimate)[0]
+        why = a.failed[0] or r.failed[0]
+        rows.append({"spread": spread, "base": base, "x": x, "failed": why or None,
+                     "error": [float(e) for e in err], "bound": [float(b) for b in bound],
+                     "reference_bound": [float(b) for b in rbound],
+                     "linear_s": t1 - t0, "reference_s": t2 - t1})
+        if not why:
+            samples.setdefault(f"{spread}, {base}", []).append((err, bound))
+    fin = [(np.array(r["error"]), np.array(r["bound"]), np.array(r["reference_bound"])) for r in rows
+           if not r["failed"]]
+    trusted = [(e, b, rb) for e, b, rb in fin if np.all(np.isfinite(b))]
+    ratio = np.concatenate([e / b for e, b, _ in trusted])
+    loose = np.concatenate([b / e for e, b, _ in trusted if np.all(e > 0)])
+    summary = {
+        "points": len(rows), "failed": sum(1 for r in rows if r["failed"]),
+        "edge (infinite bound: the first correction over a tenth of the motion)": len(fin) - len(trusted),
+        "max_error_trusted": float(max(np.max(e) for e, _, _ in trusted)),
+        "min_error_trusted": float(min(np.min(e) for e, _, _ in trusted)),
+        "max_error_over_bound": float(np.max(ratio)), "min_error_over_bound": float(np.min(ratio)),
+        "max_bound_over_error": float(np.max(loose)), "median_bound_over_error": float(np.median(loose)),
+        "beaten": int(sum(np.sum(e > b + rb) for e, b, rb in trusted)),
+        "beaten_without_reference_bound": int(sum(np.sum(e > b) for e, b, _ in trusted)),
+        "linear_s_median": float(np.median([r["linear_s"] for r in rows])),
+        "reference_s_median": float(np.median([r["reference_s"] for r in rows])),
+    }
+    return {"summary": summary, "points": rows}, samples
+
+
+def ghc_motion_edge(quick: bool) -> list:
+    """The evidence for the linear level's edge: the Earth set over 10 s and the laboratory
+    set over 400 s at growing amplitudes, the largest first step over the angles against
+    the linear motion's excursion (step/x) and the largest error over twice that step
+    (beyond 1 the bound would be beaten)."""
+    import gyro.analyses.gyrohorizoncompass as ghc
+
+    m = load(GHC)
+    out = []
+    for base_name, base, horizon, amps in (("Earth", dict(zip(m.param_names, m.vector())), 10.0,
+                                            (0.1, 0.3, 0.4, 0.6) if quick else (0.1, 0.2, 0.3, 0.4, 0.5, 0.6)),
+                                           ("laboratory", GHC_LAB, 400.0, (0.03, 0.1) if quick else (0.03, 0.1, 0.3))):
+        t = np.linspace(0.0, horizon, 201)
+        ye, A = ghc.linearisation(base)
+        for a in amps:
+            mo = ghc.Motion(base, a, a, a, a)
+            x = ghc.linear_motion(A, mo.perturbation, t)
+            step = float(np.max(np.abs(ghc.first_correction(base, ye, A, x, t, 1e-6)[:, :4])))
+            q, _ = ghc.motion_answer(mo, t, "DOP853", 1e-10)
+            err = np.max(np.abs(ye[:4] + x[:, :4] - q), axis=0)
+            out.append({"base": base_name, "horizon": horizon, "a": a,
+                        "step_over_excursion": step / float(np.max(np.abs(x[:, :4]))),
+                        "max_error_over_twice_step": float(np.max(err)) / (2 * step)})
+    return out
+
+
+def ghc_motion_figure(samples: dict) -> str:
+    """The linear motion level's measured error against its bound, one colour per spread."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    lo, hi = np.inf, 0.0
+    for i, (label, pts) in enumerate(sorted(samples.items())):
+        e = np.concatenate([p[0] for p in pts])
+        b = np.concatenate([p[1] for p in pts])
+        good = np.isfinite(b) & (e > 0)
+        if good.any():
+            ax.loglog(b[good], e[good], "o^sv<>Dph"[i % 9], ms=3.5, alpha=0.7, color=f"C{i % 10}", label=label)
+            lo, hi = min(lo, b[good].min()), max(hi, b[good].max())
+    ax.loglog([lo, hi], [lo, hi], "k-", lw=1, label="error = bound")
+    ax.loglog([lo, hi], [lo / 100, hi / 100], "k:", lw=1, label="bound 100x loose")
+    ax.set_xlabel("declared bound of level linear (relative, per coordinate)")
+    ax.set_ylabel("measured error against integrated:DOP853")
+    ax.set_title("gyrohorizoncompass: the linearised motion about (3.1) against (1.5)-(1.6)\n"
+                 "(amplitude, spin L, nu, zeta, latitude spreads; a coordinate of a motion each)", fontsize=9)
+    ax.legend(fontsize=6.5, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    fig.tight_layout()
+    name = "levels_error_gyrohorizoncompass_linear.png"
+    fig.savefig(RESULTS / name, dpi=110)
+    plt.close(fig)
+    return name
+
+
+def ghc_motion_costs(quick: bool) -> dict:
+    """The motion levels' cost per set: the default motion of the Earth set over 1 s."""
+    from gyro.questions import motion
+
+    m = load(GHC)
+    P, opts, out = m.vector()[None, :], {"horizon": 1.0}, {}
+    for lv in hierarchy.levels(m):
+        if not lv.answers_question("motion") or (quick and lv.name.endswith("Radau")):
+            continue
+        motion.answer(m, lv, P, opts)
+        out[f"{GHC} {lv.name}"] = {"s_per_set": per_set(lambda: motion.answer(m, lv, P, opts), 1, 3),
+                                   "declared": lv.cost, "batch": 1, "horizon_s": 1.0}
+    return out
+
+
+def ghc_motion(quick: bool, out: dict) -> dict:
+    """The gyrohorizoncompass's motion levels measured into `out` (levels.json's document):
+    their costs beside the others and the linear level's error map with its figure."""
+    out.setdefault("costs", {}).update(ghc_motion_costs(quick))
+    out["ghc_motion_error_map"], samples = ghc_motion_map(quick)
+    out["ghc_motion_error_map"]["quick"] = quick
+    out["ghc_motion_error_map"]["edge"] = ghc_motion_edge(quick)
+    out["ghc_motion_error_map"]["figure"] = ghc_motion_figure(samples)
+    return out
+
+
 # ------------------------------------------------------------------ speed goals
 
 
@@ -582,6 +772,8 @@ def main(argv=None) -> int:
                     help="only the scene figures (of these models; all without a name): scenes.json")
     ap.add_argument("--torsion-motion", action="store_true",
                     help="only the torsion gyrocompass's motion map (levels.json 'torsion_motion_map')")
+    ap.add_argument("--ghc-motion", action="store_true",
+                    help="only the gyrohorizoncompass's motion levels (costs, error map), into levels.json")
     args = ap.parse_args(argv)
     if args.torsion_motion:
         path = RESULTS / "levels.json"
@@ -593,6 +785,12 @@ def main(argv=None) -> int:
     if args.scenes is not None:
         scenes(args.quick, args.scenes or None)
         return 0
+    if args.ghc_motion:
+        path = RESULTS / "levels.json"
+        doc = ghc_motion(args.quick, json.loads(path.read_text()) if path.exists() else {})
+        path.write_text(json.dumps(doc, indent=1, sort_keys=True) + "\n")
+        print(json.dumps(doc["ghc_motion_error_map"]["summary"], indent=1))
+        return 0
     out = {"machine": {"python": platform.python_version(), "processor": platform.machine(),
                        "cores": os.cpu_count()}, "quick": args.quick}
     t0 = time.perf_counter()
@@ -603,6 +801,7 @@ def main(argv=None) -> int:
     out["gimbal_error_map"] = gimbal_map(args.quick)
     out["torsion_motion_map"] = torsion_motion_map(args.quick)
     out["torsion_motion_map"]["figure"] = torsion_motion_figure(out["torsion_motion_map"])
+    ghc_motion(args.quick, out)
     print(f"error maps: {time.perf_counter() - t0:.0f} s", flush=True)
     out["rungs"] = rungs(args.quick)
     out["figures"] = error_figures(samples)

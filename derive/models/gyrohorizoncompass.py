@@ -349,11 +349,23 @@ def quantities():
 def levels():
     """The hierarchy of the gyrohorizoncompass (docs/hierarchy.md): its linearised operator
     about the relative equilibrium (3.1)-(3.2) by the ladder's methods (their estimates are
-    the bounds). The nonlinear equations (1.5)-(1.6) are the motion's level, not yet a
-    level of the selector (gyro.analyses.gyrohorizoncompass has no motion_answer)."""
+    the bounds); and the motion of a perturbed equilibrium, by the linearised equations
+    (exact, e^{A t}; bounded by twice their first correction toward (1.5)-(1.6)) or by
+    (1.5)-(1.6) integrated (bounded by two tolerances compared). Motion costs: s per set
+    at the default motion of the Earth set over a horizon of 1 s (bench/levels.py)."""
     from derive.model import Bound, Level
 
     return [
+        Level("linear", "the terms of second and higher order in the perturbation of (3.1) in (1.5)-(1.6)",
+              {"kind": "trajectory", "analysis": "gyrohorizoncompass", "method": "linear", "rtol": 1e-6},
+              {"motion": Bound(estimate=True)}, cost=0.4, reference="integrated:DOP853",
+              doc="the linearised equations about (3.1) solved exactly (expm of the first-order matrix); "
+                  "the estimate twice the first correction, integrated at rtol 1e-6"),
+        Level("integrated", "nothing of (1.5)-(1.6) (the integrator's truncation: two tolerances compared)",
+              {"kind": "trajectory", "analysis": "gyrohorizoncompass", "methods": ["DOP853", "Radau"],
+               "rtol": 1e-10, "default": "DOP853"},
+              {"motion": Bound(estimate=True)}, cost={"DOP853": 1.5, "Radau": 20.0}, reference="linear",
+              doc="the emitted equations (1.5)-(1.6) integrated at rtol and rtol/100 (SciPy)"),
         Level("linear_exact", "nothing of the linearised motion about the exact relative equilibrium (3.1)",
               {"kind": "spectrum", "methods": ["polyroots", "companion", "default", "reference"], "default": "default"},
               {"frequencies": Bound(estimate=True), "stability": Bound(estimate=True)},

@@ -513,8 +513,6 @@ def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, at
     command line's BUDGET_SECONDS), stops with IntegrationBudget, saying how far it got.
     A library call has no wall-time budget: how long a run takes depends on the machine's
     load, how far it gets must not."""
-    import time
-
     t = np.asarray(t, float)
     P = param_vector(motion.params)
     y0 = np.concatenate([motion.q0, motion.qd0])
@@ -524,16 +522,7 @@ def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, at
 
         from gyro import ode
 
-        fun = ode.numpy_rhs(load(MODEL), P)
-        start, calls = time.perf_counter(), [0]
-
-        def rhs(tt, y):
-            calls[0] += 1
-            if calls[0] % 1000 == 0 and (calls[0] > budget_steps or time.perf_counter() - start > budget_s):
-                raise IntegrationBudget(f"{method} stopped at t = {tt:.6g} s of {t[-1]:.6g} s after "
-                                        f"{calls[0]} evaluations, {time.perf_counter() - start:.0f} s (its budget)")
-            return fun(tt, y)
-
+        rhs = ode.budgeted(ode.numpy_rhs(load(MODEL), P), method, t[-1], budget_s, budget_steps, IntegrationBudget)
         sol = solve_ivp(rhs, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol)
         if not sol.success:
             raise FloatingPointError(f"{method}: {sol.message}")

@@ -25,7 +25,7 @@ may be map axes: they move A and B with C and I fixed.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -419,19 +419,14 @@ def integrate(values: dict, y0: np.ndarray, t: np.ndarray, method: str = "DOP853
     if method in SCIPY_METHODS:
         from scipy.integrate import solve_ivp
 
+        from gyro import ode
+
         ca, y, p, ydot, _ = _casadi_rhs()
         f = ca.Function("f", [y, p], [ydot])
         jf = ca.Function("J", [y, p], [ca.jacobian(ydot, y)])
         kw = {"jac": lambda _, Y: np.array(jf(Y, P))} if method in ("Radau", "BDF", "LSODA") else {}
-        calls = [0]
-
-        def rhs(tt, Y):
-            calls[0] += 1
-            if calls[0] % 1000 == 0 and (calls[0] > max_steps or time.perf_counter() - start > max_s):
-                raise IntegrationBudget(f"{method} stopped at t = {tt:.6g} s of {t[-1]:.6g} s after {calls[0]} "
-                                        f"evaluations, {time.perf_counter() - start:.0f} s (its budget)")
-            return np.array(f(Y, P)).ravel()
-
+        rhs = ode.budgeted(lambda _, Y: np.array(f(Y, P)).ravel(), method, t[-1], max_s - (time.perf_counter() - start),
+                           max_steps, IntegrationBudget)
         sol = solve_ivp(rhs, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol, **kw)
         if not sol.success:
             raise FloatingPointError(f"{method}: {sol.message}")
@@ -515,3 +510,165 @@ def trajectory(values: dict, t, perturb=(0.0, 0.0, 0.0, 0.0), method: str = "DOP
     return AngleTrajectory(model=MODEL, title=model().meta["title"], method=method, t=t,
                            coordinates=("alpha", "beta", "gamma", "epsilon"), q=Y[:, :4],
                            E=energy(values, Y), params=cli_params(values))
+
+
+# ------------------------------------------------------------------ the motion question
+
+# the `motion` question's inputs beside the parameters (gyro/questions/motion.py): the
+# perturbation of the relative equilibrium (3.1), alpha = beta = gamma = 0, epsilon = epsilon0,
+# at rest, at t = 0
+INITIAL = {
+    "alpha0": ("rad", 1e-3, "alpha at t = 0 (0 at the relative equilibrium (3.1))"),
+    "beta0": ("rad", 1e-3, "beta at t = 0 (0 at the relative equilibrium)"),
+    "gamma0": ("rad", 1e-3, "gamma at t = 0 (0 at the relative equilibrium)"),
+    "delta_epsilon0": ("rad", 1e-3, "epsilon - epsilon0 at t = 0 (epsilon0 = arccos(I lambda zeta/2L), (3.1))"),
+    "dalpha0": ("rad/s", 0.0, "alpha' at t = 0"),
+    "dbeta0": ("rad/s", 0.0, "beta' at t = 0"),
+    "dgamma0": ("rad/s", 0.0, "gamma' at t = 0"),
+    "depsilon0": ("rad/s", 0.0, "epsilon' at t = 0"),
+}
+LINEAR = "linear"  # motion_answer's method: the linearised equations about (3.1)
+FIRST_STEP_FACTOR = 2.0  # the linear motion's estimate: this times its first correction
+# where the first correction exceeds this fraction of the linear motion's largest excursion
+# (over the angles), one step does not resolve the linearisation's error and the estimate
+# is infinite (measured, bench/levels.py `ghc_motion_edge`: the error stays below twice the
+# first step up to a ratio of 0.3, 0.64 of it there; at 0.4 it is 1.1 times it, at 0.6 3.7
+# times, the Earth set over 10 s); and where it exceeds this fraction of a
+# radian: no tolerance below 1 on a scale of at least 1 rad needs more, and an unstable
+# linear motion that has grown to radians may cross beta = +-90 deg, where the angles (1.1)
+# are singular (the mass matrix of (1.5)-(1.6) is) and the remainder cannot be evaluated
+FIRST_STEP_SMALL = 0.1
+
+
+@dataclass(frozen=True)
+class Motion:
+    """A motion of the gyrohorizoncompass: parameters (model keys, `lam`) and the perturbation
+    of the relative equilibrium at t = 0 (INITIAL)."""
+
+    params: dict
+    alpha0: float = INITIAL["alpha0"][1]
+    beta0: float = INITIAL["beta0"][1]
+    gamma0: float = INITIAL["gamma0"][1]
+    delta_epsilon0: float = INITIAL["delta_epsilon0"][1]
+    dalpha0: float = 0.0
+    dbeta0: float = 0.0
+    dgamma0: float = 0.0
+    depsilon0: float = 0.0
+
+    @property
+    def perturbation(self) -> np.ndarray:
+        """x0 = y(0) - ye, y = (q, q')."""
+        return np.array([self.alpha0, self.beta0, self.gamma0, self.delta_epsilon0,
+                         self.dalpha0, self.dbeta0, self.dgamma0, self.depsilon0], float)
+
+
+def linearisation(values: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(ye, A): the state of the relative equilibrium (3.1), (0, 0, 0, epsilon0) at rest, and
+    the first-order matrix A = [[0, I], [-M^-1 K, -M^-1 D]] of the emitted operator there,
+    the exact linearisation the linear_exact levels take the spectrum of (it is the
+    Jacobian of the emitted equations at ye)."""
+    check_equilibrium(values)
+    ye = initial_state(values)
+    M, D, K = operators(model(), model().vector(values)[None], ye[None, :4])
+    return ye, companion_matrix(M[0], D[0], K[0])
+
+
+def linear_motion(A: np.ndarray, x0: np.ndarray, t) -> np.ndarray:
+    """x(t) = e^{A t} x0 at the times t (times, 2n), the exact solution of x' = A x, step
+    by step: x(t_k+1) = e^{A (t_k+1 - t_k)} x(t_k), SciPy's expm over the batch of the
+    steps (of small norm, so a few Pade terms each: e^{A t_k} itself over a horizon of
+    many periods costs twenty times more)."""
+    from scipy.linalg import expm
+
+    E = expm(A[None] * np.diff(np.asarray(t, float))[:, None, None])
+    out = [np.asarray(x0, float)]
+    for Ek in E:
+        out.append(Ek @ out[-1])
+    return np.array(out)
+
+
+def _rounding(A: np.ndarray, x: np.ndarray, t) -> np.ndarray:
+    """Twice the difference of the stepped linear motion at the horizon's end to the other
+    route there, e^{A (t_N - t_0)} x0 at once (per component): the rounding of the two,
+    which the steps accumulate toward the end."""
+    from scipy.linalg import expm
+
+    t = np.asarray(t, float)
+    return 2 * np.abs(expm(A * (t[-1] - t[0])) @ x[0] - x[-1])
+
+
+def first_correction(values: dict, ye: np.ndarray, A: np.ndarray, x: np.ndarray, t, rtol: float,
+                     budget_s: float | None = None, limit: float = math.inf) -> np.ndarray:
+    """d(t) (times, 8): the response of the linearised equations to the remainder of
+    (1.5)-(1.6) along the linear motion, d' = A d + f(ye + x) - A x, d(0) = 0 (gyro.ode.
+    correction_rhs), integrated beside x' = A x from x(0) = x[0] by DOP853 at rtol; the
+    absolute tolerance of each component is rtol/100 of its linear motion's largest size
+    over the times t (of x: the linear motion at t) and of the largest such size squared
+    (of d: the remainder is of second order in x). The run stops where the largest of
+    the angles' d reaches `limit`; d is infinite from there on (on an unstable set whose
+    linear motion grows, the correction would grow with its square)."""
+    from scipy.integrate import solve_ivp
+
+    from gyro import ode
+
+    t = np.asarray(t, float)
+    xs = np.max(np.abs(x), axis=0)
+    size = max(float(np.max(xs)), np.finfo(float).tiny)
+    atol = rtol * 1e-2 * np.concatenate([np.maximum(xs, size * 1e-6), np.full(8, size**2)])
+    fun = ode.correction_rhs(model(), model().vector(values), ye, A)
+    max_s = math.inf if budget_s is None else budget_s
+    rhs = ode.budgeted(fun, "the linear motion's first correction", t[-1], max_s, BUDGET_STEPS, IntegrationBudget)
+
+    def reached(_, z):
+        return limit - np.max(np.abs(z[8:12]))
+
+    reached.terminal = True
+    sol = solve_ivp(rhs, (t[0], t[-1]), np.concatenate([x[0], np.zeros(8)]), method="DOP853", t_eval=t,
+                    rtol=rtol, atol=atol, events=reached)
+    if not sol.success:
+        raise FloatingPointError(f"the linear motion's first correction: {sol.message}")
+    d = np.full((t.size, 8), np.inf)
+    d[:sol.y.shape[1]] = sol.y.T[:, 8:]
+    return d
+
+
+def motion_answer(motion: Motion, t, method: str = LINEAR, rtol: float = RTOL):
+    """The `motion` question's evaluator (gyro/questions/motion.py, docs/hierarchy.md): the
+    coordinates alpha, beta, gamma, epsilon at the times t (times, 4) from the perturbed
+    relative equilibrium, and an estimate of each one's largest absolute error over t (rad).
+
+    `linear`: the motion of the linearised equations, ye + e^{A t} x0, exact (expm). Its
+    estimate against the motion of (1.5)-(1.6), the same for the four angles: twice the
+    largest first correction d over them (`first_correction`, at rtol; d is the linear
+    motion's error to second order in x0, per coordinate), plus the rounding (`_rounding`:
+    two routes of expm compared) and that of ye + x. Measured (bench/levels.py,
+    docs/hierarchy.md): the error is d to within its next order, so twice d bounds it
+    where the first correction is small against the motion; where it exceeds
+    FIRST_STEP_SMALL of the linear motion's largest excursion (or of a radian) the
+    estimate is infinite (the selector goes on to an integrator).
+
+    An integrator of METHODS: the equations (1.5)-(1.6) integrated at rtol and rtol/100
+    (gyro.ode.two_tolerances; within the command line's budget)."""
+    t = np.asarray(t, float)
+    values = motion.params
+    ye, A = linearisation(values)
+    x0 = motion.perturbation
+    if method == LINEAR:
+        x = linear_motion(A, x0, t)
+        rounding = _rounding(A, x, t)[:4]
+        limit = FIRST_STEP_SMALL * min(float(np.max(np.abs(x[:, :4]))), 1.0)
+        d = first_correction(values, ye, A, x, t, rtol, BUDGET_SECONDS, limit)
+        q = ye[:4] + x[:, :4]
+        # the largest first step over the four angles (one unit): the next step carries a
+        # large correction of one angle into the others through the coupling (near zeta = 0,
+        # where alpha's restoring moment I (1 + theta) zeta^2 vanishes, alpha's step is 200 times
+        # the others', whose errors then reach 5 times their own steps)
+        step = float(np.max(np.abs(d[:, :4])))
+        if not step <= limit:
+            return q, np.full(4, np.inf)  # the linearisation fails: its error is not one small step
+        return q, FIRST_STEP_FACTOR * step + rounding + U * np.max(np.abs(q), axis=0)
+    from gyro import ode
+
+    y0 = ye + x0
+    return ode.two_tolerances(lambda r: integrate(values, y0, t, method, r, r * 1e-2, budget_s=BUDGET_SECONDS,
+                                                  budget_steps=BUDGET_STEPS)[:, :4], rtol)

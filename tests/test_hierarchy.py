@@ -265,11 +265,6 @@ def test_a_batch_gets_a_level_per_set_and_says_which(tg):
     assert any(r.startswith("a-priori bound") for lv, r in s.tried(2) if lv == "linear_paper")
 
 
-# The approximate levels' bounds are up to this many times their error where they are tight:
-# the derived estimates are twice the first-order error by construction, the paper operator's
-# error reaches 0.21 of its bound (bench/results/levels.json), so a level is needed where its
-# error is below tol / 5.
-LOOSENESS = 5.0
 
 
 @settings(max_examples=30, deadline=None, derandomize=True, phases=[Phase.explicit, Phase.generate])
@@ -277,13 +272,13 @@ LOOSENESS = 5.0
 def test_the_actual_error_never_exceeds_the_tolerance(seed, tol):
     """Random sets of the spreads and random tolerances: the selected level's frequencies
     lie within tol of the exact ones, and the chosen level is at most one rung above the
-    cheapest level whose measured error meets tol with the margin its bound needs, tol /
-    LOOSENESS (rungs: the levels that answer every requested quantity and are not dominated
-    on these sets, cheapest first: gyro.analyses.scene.rungs).
-    Without the margin the selector cannot know that a level whose bound exceeds tol is
-    within it all the same (bench/results/levels.json 'rungs', 400 joint sets: 13 go two
-    rungs up at 1e-3 and at 1e-4 with no margin, 1 with this one, where a formula's
-    estimate is 80 times its error). The exact frequencies are the default method's,
+    cheapest level whose measured error meets tol (rungs: the levels that answer every
+    requested quantity and are not dominated on these sets, cheapest first:
+    gyro.analyses.scene.rungs; bench/results/levels.json 'rungs' holds it on 400 joint
+    sets at every tolerance). Counted over every level instead, the quartic (costlier than
+    the paper operator, and bounded by its bound and more) stands between linear_paper and
+    the exact operator, and 51 of 400 sets at 1e-3, 178 at 1e-4 go "two rungs" up past it
+    wherever linear_paper errs less than its bound says. The exact frequencies are the default method's,
     whose own error (its estimate, <= 1e-10 relative) is added to the allowance: the
     comparison |f - f_default| <= (tol + e_default) f follows from |f - f_exact| <= tol f."""
     from gyro import ladder
@@ -305,7 +300,7 @@ def test_the_actual_error_never_exceeds_the_tolerance(seed, tol):
         f = np.array(s.document(k)["frequencies"])
         allow = (tol + ref.error_estimate[k]) * ref.frequencies[k]
         assert np.all(np.abs(f - ref.frequencies[k]) <= allow), (s.level[k], tol)
-        adequate = [n for n, e in measured.items() if np.all(e[k] <= tol / LOOSENESS)] or [s.level[k]]
+        adequate = [n for n, e in measured.items() if np.all(e[k] <= tol)] or [s.level[k]]
         assert names.index(s.level[k]) <= names.index(adequate[0]) + 1, (s.level[k], adequate, tol)
 
 

@@ -355,21 +355,25 @@ def test_scene_refuses_in_one_line(args, code, says):
 
 
 def test_a_tolerance_past_every_level_exits_1_saying_so():
-    """The gyrohorizoncompass's spectrum has a neutral root (frequency 0): no relative bound
-    of it is finite at any level, so no tolerance is met (and the 40-digit level is cheap
-    for its 4 coordinates: the torsion gyrocompass's would take seconds)."""
+    """Below the 40-digit level's own bound (1e-35 for the gyrohorizoncompass at (3.1); its
+    4 coordinates make that level cheap, the torsion gyrocompass's would take seconds)."""
     rc, out, err = run_cli("scene", "gyrohorizoncompass", "frequencies", "--tol", "1e-40")
     assert rc == 1 and "can promise" in err and len(err.strip().splitlines()) == 1 and out == ""
 
 
 def test_a_divergent_real_pair_is_no_neighbour_of_the_slow_mode():
-    """The gyrohorizoncompass's illustrative set diverges (a real pair, frequency 0, growth
-    0.10 rad/s), and its spectrum ranks that root by |lambda|, between omega = 9.4e-4 and
-    2.1 rad/s. The question answers in ascending frequency (the 0 first), neighbours are
-    neighbours in frequency, and the 0 does not touch 9.4e-4's interval: answered (it was
-    refused as 'modes 1 and 2 within their bounds of each other')."""
-    rc, out, err = run_cli("scene", "gyrohorizoncompass", "frequencies", "--tol", "0.1", "--json")
-    assert rc == 0, err
-    d = json.loads(out)
-    assert d["level"] == "linear_exact:default" and d["frequencies"][0] == 0.0
-    assert d["frequencies"] == sorted(d["frequencies"])
+    """A spectrum ranked by |lambda| puts a divergent real pair (frequency 0, growth 0.10
+    rad/s) between omega = 9.4e-4 and 2.1 rad/s (the gyrohorizoncompass's spectrum about its
+    other relative equilibrium, epsilon = 0, which the runtime took before it started from
+    (3.1)). The question answers in ascending frequency (the 0 first), neighbours are
+    neighbours in frequency, and the 0 does not touch 9.4e-4's interval (it was refused as
+    'modes 1 and 2 within their bounds of each other')."""
+    from gyro.questions import frequencies as F
+
+    f = np.array([[9.44614959e-04, 0.0, 2.11074166, 178.899135]])
+    g = np.array([[0.0, 0.10248097, 0.0, 0.0]])
+    f2, e2, g2 = F._ascending(f, np.full(f.shape, 1e-13), g)
+    assert list(f2[0]) == [0.0, 9.44614959e-04, 2.11074166, 178.899135] and g2[0, 0] == 0.10248097
+    edge = F.edges(load("gyrohorizoncompass"), F.Answer(f2, e2, np.array([""], object), {}), e2, range(4),
+                   np.ones(4, bool))
+    assert edge[0] == ""

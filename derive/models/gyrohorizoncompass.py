@@ -390,4 +390,8 @@ def build():
         quantities=quantities(),
         levels=levels(),
         aliases=CLI_NAMES,
+        # the start of the runtime's Newton: (3.1) itself (from zero it found the other
+        # relative equilibrium, epsilon = 0 with beta = 1.1e-3 at the Earth set, unstable)
+        equilibrium_approx={"alpha": sp.Integer(0), "beta": sp.Integer(0), "gamma": sp.Integer(0),
+                            "epsilon": epsilon0()},
     )

@@ -19,7 +19,9 @@ def functions(d) -> list[Function]:
         even_names = [str(x) for x in d.even]
         fns.append(Function("equilibrium_approx", [("params", model.symbols)],
                             [("qe", sp.Matrix([model.equilibrium_approx[c] for c in even_names]))],
-                            f"Approximate equilibrium (2.2) of {', '.join(even_names)}."))
+                            f"The model's approximate equilibrium of {', '.join(even_names)}, where "
+                            "the runtime's Newton starts (the torsion gyrocompass's (2.2), the "
+                            "gyrohorizoncompass's (3.1))."))
     return fns
 
 

@@ -18,8 +18,13 @@ DPS = 40
 
 
 def _mp_equilibrium(mf, p, q0, idx, max_iter=60):
+    """Newton in the working precision from q0. Converged where every step is within tol of
+    its coordinate, or, for a coordinate far smaller than the others (the gyrohorizoncompass's
+    beta = 5e-20 at (3.1), where its steps stay at the rounding of the others' residual),
+    where the largest step is within tol of the largest coordinate and no longer shrinks."""
     q = [mpmath.mpf(v) for v in q0]
     tol = mpmath.mpf(10) ** (-mpmath.mp.dps + 5)
+    last = None
     for _ in range(max_iter):
         r = mf.equilibrium_residual(p, q)
         _, _, K = mf.operator(p, q)
@@ -28,6 +33,10 @@ def _mp_equilibrium(mf, p, q0, idx, max_iter=60):
         q = [qi + dqi for qi, dqi in zip(q, dq)]
         if all(abs(d) <= tol * max(abs(v), mpmath.mpf(10) ** -300) for d, v in zip(dq, q)):
             return q
+        step = max(abs(d) for d in dq)
+        if last is not None and step <= tol * max(abs(v) for v in q) and step > last / 2:
+            return q  # at the rounding floor
+        last = step
     raise EquilibriumError("Newton's method in extended precision did not converge")
 
 

@@ -55,7 +55,14 @@ def test_pendulous_gyrocompass_is_stable_with_ten_frequencies(values):
     assert np.max(np.abs(r.eigenvalues_re)) <= 1e-9 * f.max()
     # omega5 = omega_p (3.7) is exact at u = 0 and zero offsets; the Coriolis couplings
     # (2 u2 p between x1 and x3) shift it by O(u/omega_p) < 1e-6, the offsets by their
-    # squares (~1e-9): a 1e-6 band (a crossing with another branch would break it, and is
-    # what hypothesis would find)
+    # squares (~1e-9): a 1e-6 band. Near another branch the two veer and omega_p moves by
+    # (coupling)^2 / gap: with couplings up to ~1e-4 relative, by up to 1e-6 at a gap of 1 %
+    # (hypothesis found l2 = 0.063, I1 = 0.0023: a branch 0.26 % below omega_p and omega_p
+    # moved by 1.01e-6), so the band holds where no other frequency lies within 1 %
     wp = np.sqrt(values["Kp"] / values["m"])
-    assert np.min(np.abs(f / wp - 1)) < 1e-6
+    j = int(np.argmin(np.abs(f / wp - 1)))
+    others = np.delete(f, j)
+    if np.min(np.abs(others / wp - 1)) > 1e-2:
+        assert abs(f[j] / wp - 1) < 1e-6
+    else:  # veering: the mode stays within the band the coupling allows at that gap
+        assert abs(f[j] / wp - 1) < 1e-8 / np.min(np.abs(others / wp - 1))

@@ -379,8 +379,32 @@ def _mode_select(functions: list[Function]) -> dict | None:
     for fn in functions:
         if fn.name == "mode_formulas":
             omega = dict(fn.outputs)["omega"]
-            return {"modes": omega.rows, "cands": omega.cols, "n_params": len(fn.inputs[0][1])}
+            return {"modes": omega.rows, "cands": omega.cols, "n_params": len(fn.inputs[0][1]),
+                    "network": sorting_network(omega.rows)}
     return None
+
+
+def sorting_network(n: int) -> list[tuple[int, int]]:
+    """Batcher's odd-even merge sort of n keys as comparators (a, b), a < b, in order: the
+    network for the next power of two with every comparator that touches a key past n
+    dropped (those keys count as larger than all, so it would never swap). After it, key a
+    is at most key b for every a < b (tests/test_ladder.py checks it on all 0-1 inputs, which
+    suffices for a comparator network)."""
+    size = 1
+    while size < n:
+        size *= 2
+    out, p = [], 1
+    while p < size:
+        k = p
+        while k >= 1:
+            for j in range(k % p, size - k, 2 * k):
+                for i in range(min(k, size - j - k)):
+                    a, b = i + j, i + j + k
+                    if a // (2 * p) == b // (2 * p) and b < n:
+                        out.append((a, b))
+            k //= 2
+        p *= 2
+    return out
 
 
 # calls that are instructions of the compiler's SIMD (no -ffast-math needed to vectorise them)

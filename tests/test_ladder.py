@@ -566,3 +566,42 @@ def test_the_formulas_in_lanes_are_the_set_by_set_formulas_to_the_last_bit():
     assert np.isnan(lanes.frequencies[17]).any()
     np.testing.assert_array_equal(lanes.frequencies, f)
     np.testing.assert_array_equal(lanes.error_estimate, e)
+
+
+def test_the_sorting_network_of_the_lanes_sorts_every_input():
+    """The comparators the lanes sort the modes with (derive.emit.sorting_network) sort
+    every sequence of zeros and ones, for up to 16 keys; by the 0-1 principle they then sort
+    every sequence, and with (frequency, row) keys, all distinct, every input ends in the one
+    order the set-by-set stable insertion sort gives."""
+    import itertools
+
+    from derive.emit import sorting_network
+
+    for n in range(1, 17):
+        net = sorting_network(n)
+        assert all(0 <= a < b < n for a, b in net)
+        v = np.array(list(itertools.product((0, 1), repeat=n)))
+        for a, b in net:
+            lo, hi = np.minimum(v[:, a], v[:, b]), np.maximum(v[:, a], v[:, b])
+            v[:, a], v[:, b] = lo, hi
+        assert np.all(np.diff(v, axis=1) >= 0), n
+
+
+def test_the_formulas_outputs_in_huge_pages_are_plain_writable_arrays():
+    """gyro.cbackend.empty_huge, where the compiled formulas write: the shape asked for, C
+    order, writable, on a 2 MB boundary from 2 MB up on Linux (a view of a longer buffer, not
+    a copy); a small one is plain np.empty; the spectrum's two outputs are views of one."""
+    import sys
+
+    from gyro import cbackend
+
+    for shape in [(2, 3, 10), (2, 20000, 10), (2, 200001, 10)]:
+        a = cbackend.empty_huge(shape)
+        assert a.shape == shape and a.dtype == float and a.flags.c_contiguous and a.flags.writeable
+        a[...] = 1.5
+        assert np.all(a == 1.5) and a[0].flags.c_contiguous and a[1].flags.c_contiguous
+        if a.nbytes >= 2 << 20 and sys.platform.startswith("linux"):
+            assert a.ctypes.data % (2 << 20) == 0
+    P = np.tile(params(), (30000, 1))
+    s = ladder.spectrum(MODEL, P, "formulas")
+    np.testing.assert_array_equal(s.frequencies, np.tile(ladder.spectrum(MODEL, P[:1], "formulas").frequencies, (30000, 1)))

@@ -7,9 +7,14 @@ same flags (gyro.cbackend.FLAGS without -shared and -fPIC) into one harness that
 through a function pointer N times on the model's defaults (a pointer call across
 translation units: nothing inlined or hoisted), alternating ours and CasADi's, R times. The
 figures are medians in ns per evaluation and the ratio ours / CasADi's (< 1: ours faster),
-measured in the same process on a shared machine. CasADi writes only the structural
-nonzeros of an output (its caller zeroes the rest once); ours writes every entry: the
-column "outputs (CasADi nonzeros)" shows where that counts. Writes bench/results/codegen_casadi.json
+measured in the same process on a shared machine, with the quartiles of the ratio run by
+run (their spread: quartiles on both sides of 1 are no measured difference). Both write only
+the structural nonzeros of an output (their caller zeroes the rest once:
+generated/<model>/<model>.h's contract);
+ours at their positions in the row-major matrix, CasADi's packed column after column.
+Ours' time includes that zeroing (a memset of its outputs before each run of N calls, as
+CasADi's packed values in the shared buffers are not ours' zeros). The column "outputs
+(CasADi nonzeros)" shows where the layout counts. Writes bench/results/codegen_casadi.json
 and the table bench/results/codegen_casadi.md.
 """
 from __future__ import annotations
@@ -35,6 +40,7 @@ FLAGS = [f for f in cbackend.FLAGS if f not in ("-shared", "-fPIC")]
 HARNESS = r"""#define _POSIX_C_SOURCE 199309L
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 typedef long long casadi_int;
 %(decls)s
@@ -104,7 +110,8 @@ def one_model(name: str, evals: int, repeats: int, tmp: Path) -> list[dict]:
         lines.append(f"    void (*volatile ours)({', '.join(['const double *'] * len(ins) + ['double *'] * len(outs))}) = {name}_{fname};")
         lines.append(f"    int (*volatile theirs)(const double **, double **, casadi_int *, double *, int) = {fname};")
         lines.append("    for (long r = 0; r < repeats; ++r) {")
-        lines.append(f"      double t0 = now(); for (long e = 0; e < evals; ++e) {{ ours({ours_args}); sink += out0[0]; }}")
+        zero = " ".join(f"memset(out{j}, 0, sizeof out{j});" for j in range(len(outs)))
+        lines.append(f"      double t0 = now(); {zero} for (long e = 0; e < evals; ++e) {{ ours({ours_args}); sink += out0[0]; }}")
         lines.append("      double t1 = now(); for (long e = 0; e < evals; ++e) { theirs(arg, res, iw, w, 0); sink += out0[0]; }")
         lines.append(f"      double t2 = now(); printf(\"%d %.6e %.6e\\n\", (t1 - t0) / evals, (t2 - t1) / evals);", )
         lines.append("    }")
@@ -134,6 +141,8 @@ def one_model(name: str, evals: int, repeats: int, tmp: Path) -> list[dict]:
         row["ours_ns"] = float(np.median(a[:, 0]) * 1e9)
         row["casadi_ns"] = float(np.median(a[:, 1]) * 1e9)
         row["ratio_ours_over_casadi"] = row["ours_ns"] / row["casadi_ns"]
+        # the spread of the ratio run by run (each run times ours, then CasADi's, back to back)
+        row["ratio_quartiles"] = [float(q) for q in np.percentile(a[:, 0] / a[:, 1], [25, 75])]
     return rows
 
 
@@ -147,11 +156,13 @@ def main(argv=None) -> int:
         for name in available():
             print(f"{name}: CasADi's code generator and ours, same compiler and flags ...", flush=True)
             rows += one_model(name, args.evals, args.repeats, Path(tmp))
-    lines = ["| model | function | outputs (CasADi nonzeros) | ours ns/eval | CasADi ns/eval | ours / CasADi |",
-             "|---|---|---|---|---|---|"]
+    lines = ["| model | function | outputs (CasADi nonzeros) | ours ns/eval | CasADi ns/eval | ours / CasADi "
+             "| run by run: quartiles |", "|---|---|---|---|---|---|---|"]
     for r in rows:
+        q = r["ratio_quartiles"]
         lines.append(f"| {r['model']} | {r['function']} | {r['outputs']} ({r['output_nonzeros_casadi']}) | "
-                     f"{r['ours_ns']:.1f} | {r['casadi_ns']:.1f} | {r['ratio_ours_over_casadi']:.2f} |")
+                     f"{r['ours_ns']:.1f} | {r['casadi_ns']:.1f} | {r['ratio_ours_over_casadi']:.2f} | "
+                     f"{q[0]:.2f}-{q[1]:.2f} |")
         print(f"  {r['model']:22s} {r['function']:22s} ours {r['ours_ns']:9.1f} ns  CasADi {r['casadi_ns']:9.1f} ns"
               f"  ratio {r['ratio_ours_over_casadi']:.2f}")
     RESULTS.mkdir(parents=True, exist_ok=True)

@@ -9,6 +9,9 @@ common-subexpression elimination; the same CSE is printed four ways:
 An output that its `Function` declares sparse is emitted as its structural nonzeros alone,
 in every backend: a flat vector of values (row-major over the matrix) whose (row, column)
 positions metadata.json lists under the output's "nonzeros".
+The C writes the structural nonzeros of an output alone, each stored as soon as the
+temporaries it needs are known (`_schedule`); its structural zeros are the caller's to zero
+once (the contract in templates/model.h.j2; the `_batch` entry points zero them themselves).
 Every file starts with a header naming the template it came from, saying it must not be
 edited, and carrying a hash of the inputs that made it (the shared machinery of `derive/`,
 the templates, the model's own file or folder and the pinned SymPy, SymEngine and CasADi
@@ -183,6 +186,9 @@ class EmittedFunction:
     outputs: list[Output]
     ops: int  # operations after CSE
     ops_before: int  # operations before CSE
+    # the C statements in their order (_schedule): (temporary name, None, expression) or
+    # (output name, position in the emitted array, expression)
+    body: list = ()
 
 
 def _cse(fn: Function):
@@ -200,7 +206,42 @@ def _cse(fn: Function):
     return temps, reduced, ops, ops_before
 
 
-def _printed(fn, temps, reduced, ops, ops_before, printer) -> EmittedFunction:
+def _schedule(temps, reduced) -> list:
+    """The order of the C statements: the outputs' nonzero entries in turn (row-major, output
+    after output), each preceded by the temporaries it needs that are not computed yet,
+    depth first. Values are those of the CSE in its own order (each statement is the same
+    expression); what changes is how long a temporary lives: stored into the output as
+    soon as it is known, not all temporaries first, which kept hundreds live across the
+    calls to sin and cos (spilled to the stack). The temporaries that call a function come
+    first (with what they need): little is live across the calls then. Returns ("t", i)
+    for temps[i] and ("o", k) for reduced[k], the temporaries no output needs left out."""
+    index = {t: i for i, (t, _) in enumerate(temps)}
+    uses = lambda e: sorted(index[s] for s in e.free_symbols if s in index)  # noqa: E731
+    deps = [uses(e) for _, e in temps]
+    done, order = [False] * len(temps), []
+    calls = [i for i, (_, e) in enumerate(temps) if e.atoms(sp.Function)]
+    for k, e in [(None, None)] + list(enumerate(reduced)):
+        if k is not None and e == 0:
+            continue
+        for root in (calls if k is None else uses(e)):  # post-order depth first, iteratively
+            stack = [(root, 0)]
+            while stack:
+                i, j = stack.pop()
+                if done[i]:
+                    continue
+                if j < len(deps[i]):
+                    stack.append((i, j + 1))
+                    if not done[deps[i][j]]:
+                        stack.append((deps[i][j], 0))
+                else:
+                    done[i] = True
+                    order.append(("t", i))
+        if k is not None:
+            order.append(("o", k))
+    return order
+
+
+def _printed(fn, temps, reduced, ops, ops_before, printer, schedule=None) -> EmittedFunction:
     outs, k = [], 0
     for name, mat in fn.outputs:
         mat = sp.Matrix(mat)
@@ -212,11 +253,21 @@ def _printed(fn, temps, reduced, ops, ops_before, printer) -> EmittedFunction:
         outs.append(Output(name, mat.rows, mat.cols, entries,
                            vector=mat.cols == 1 and name not in fn.matrices, sparse=name in fn.sparse))
         k += mat.rows * mat.cols
+    printed_temps = [(str(t), printer.doprint(e)) for t, e in temps]
+    body = []
+    if schedule is not None:  # flat entry k -> (output name, position in its emitted array)
+        where, k = {}, 0
+        for o in outs:
+            for pos, (idx, e) in enumerate(o.entries):
+                where[k + idx] = (o.name, pos if o.sparse else idx, e)
+            k += o.rows * o.cols
+        body = [(printed_temps[i][0], None, printed_temps[i][1]) if kind == "t" else where[i]
+                for kind, i in schedule]
     return EmittedFunction(
         name=fn.name, doc=fn.doc,
         inputs=[Input(n, [str(s) for s in syms]) for n, syms in fn.inputs],
-        temps=[(str(t), printer.doprint(e)) for t, e in temps],
-        outputs=outs, ops=int(ops), ops_before=int(ops_before))
+        temps=printed_temps,
+        outputs=outs, ops=int(ops), ops_before=int(ops_before), body=body)
 
 
 # --------------------------------------------------------------------------- files
@@ -461,8 +512,10 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
     emitted = {k: [] for k in printers}
     for fn in functions:
         temps, reduced, ops, ops_before = _cse(fn)
+        schedule = _schedule(temps, reduced)
         for key, printer in printers.items():
-            emitted[key].append(_printed(fn, temps, reduced, ops, ops_before, printer))
+            emitted[key].append(_printed(fn, temps, reduced, ops, ops_before, printer,
+                                         schedule if key == "c" else None))
     source = _shown(module_file)
     common = dict(model=model.name, title=model.title, paper=model.source, source=source,
                   digest=digest, versions=tool_versions(), prefix=model.name, qep_n=_operator_dim(functions),

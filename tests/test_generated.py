@@ -125,13 +125,17 @@ def _dense(fn, outs, model):
 
 
 def _call_c(lib, fn, vals, model=MODEL):
-    args, outs = [], []
-    for _, syms in fn.inputs:
-        args.append((ctypes.c_double * len(syms))(*[vals[s] for s in syms]))
-    for size in _sizes(fn, model):
-        outs.append((ctypes.c_double * size)())
+    """The single-set entry point into fresh output arrays (ctypes zeroes them: the
+    structural zeros are the caller's, model.h)."""
+    outs = [(ctypes.c_double * size)() for size in _sizes(fn, model)]
+    return _dense(fn, _call_c_into(lib, fn, vals, outs, model), model)
+
+
+def _call_c_into(lib, fn, vals, outs, model):
+    """The single-set entry point at vals into the given ctypes output arrays."""
+    args = [(ctypes.c_double * len(syms))(*[vals[s] for s in syms]) for _, syms in fn.inputs]
     getattr(lib, f"{model}_{fn.name}")(*args, *outs)
-    return _dense(fn, [list(b) for b in outs], model)
+    return [np.array(list(o)) for o in outs]
 
 
 def _call_numpy(fn, vals, model=MODEL):
@@ -257,6 +261,46 @@ def test_generated_code_matches_symbolic(name, fname, compiled):
     for one, many in zip(singles, _call_c_batch(lib, fn, points, name)):
         for a, b in zip(one, many):
             np.testing.assert_array_equal(a, b)
+
+
+SENTINEL = -7.25e307  # no output takes it: left where the C writes nothing
+
+
+@pytest.mark.parametrize("name, fname", FUNCTIONS, ids=[f"{n}.{f}" for n, f in FUNCTIONS])
+def test_c_calling_contract_nonzeros_once_zeroed_and_reused(name, fname, compiled):
+    """The contract of model.h: a single-set call writes exactly the structural nonzeros
+    of each output (a sentinel survives at the symbolic zeros and nowhere else), so an
+    output array zeroed once and called into again with other inputs holds the answer at
+    the new inputs, to the bit (no value of the earlier call left); the batch entry point
+    writes every entry of arrays that held anything."""
+    model, _, functions = derived(name)
+    lib = compiled(name)
+    fn = functions[fname]
+    rng = random.Random(f"contract:{name}:{fname}")
+    points = [_random_inputs(fn, model, rng) for _ in range(3)]
+    sizes = _sizes(fn, name)
+    fresh = lambda: [(ctypes.c_double * k)() for k in sizes]  # noqa: E731  (ctypes zeroes them)
+    for (oname, mat), nz, got in zip(fn.outputs, _nonzeros(name, fname),
+                                     _call_c_into(lib, fn, points[0], [(ctypes.c_double * k)(*[SENTINEL] * k)
+                                                                       for k in sizes], name)):
+        if nz is None:
+            zero = np.array([sp.sympify(e) == 0 for e in sp.Matrix(mat)])
+        else:  # emitted as its nonzeros: every value written
+            zero = np.zeros(len(nz[0]), dtype=bool)
+        np.testing.assert_array_equal(got == SENTINEL, zero, err_msg=f"{fname}.{oname}: positions written")
+    reused = fresh()
+    for k, vals in enumerate(points):
+        again = _call_c_into(lib, fn, vals, reused, name)
+        once = _call_c_into(lib, fn, vals, fresh(), name)
+        for a, b in zip(again, once):
+            np.testing.assert_array_equal(a, b, err_msg=f"{fname}: call {k} into a reused output")
+    ptr = ctypes.POINTER(ctypes.c_double)
+    ins = [np.array([[v[s] for s in syms] for v in points]) for _, syms in fn.inputs]
+    outs = [np.full((len(points), k), SENTINEL) for k in sizes]
+    getattr(lib, f"{name}_{fname}_batch")(ctypes.c_long(len(points)), *[a.ctypes.data_as(ptr) for a in ins + outs])
+    for k, vals in enumerate(points):
+        for a, b in zip([o[k] for o in outs], _call_c_into(lib, fn, vals, fresh(), name)):
+            np.testing.assert_array_equal(a, b, err_msg=f"{fname}: the batch over arrays that held a sentinel")
 
 
 def test_numpy_functions_broadcast_over_a_batch(tg_model):

@@ -477,6 +477,29 @@ def test_refinement_steps_agree_root_by_root():
     np.testing.assert_allclose(ec, en, rtol=1e-3)
 
 
+def test_a_lane_whose_step_fails_is_taken_again_by_the_pivoted_steps():
+    """A start on a root to the last bit makes J(i w) exactly singular (here a zero row: M = I,
+    D = 0, K = diag(k^2), w = 1): that lane's step in the compiled refinement fails, and the
+    set's root is taken again from its start by the scalar steps, whose shifts move off the
+    root; the other lanes of its group are not touched, and the set's answer is the one it
+    gets alone (a tail of one set, the same path)."""
+    from gyro.cbackend import qep_refine
+
+    n, sets = 10, 9  # the torsion gyrocompass operator: 10 x 10
+    roots = np.arange(n) + 1.0
+    M, D, K = np.tile(np.eye(n), (sets, 1, 1)), np.zeros((sets, n, n)), np.tile(np.diag(roots**2), (sets, 1, 1))
+    w0 = np.tile(roots * (1 + 1e-3), (sets, 1))
+    w0[3, 0] = 1.0
+    z0 = qep.start_vectors(sets, n, n)
+    refine = qep_refine(MODEL.name)
+    w, _, e, ok = refine(M, D, K, w0, z0, 3, ladder.DEFAULT_TOL)
+    assert ok.all() and np.all(e <= ladder.DEFAULT_TOL)
+    np.testing.assert_allclose(w, np.tile(roots, (sets, 1)), rtol=1e-14)
+    alone = refine(M[3:4], D[3:4], K[3:4], w0[3:4], z0[3:4], 3, ladder.DEFAULT_TOL)
+    np.testing.assert_array_equal(alone[0][0], w[3])
+    np.testing.assert_array_equal(alone[2][0], e[3])
+
+
 def _cli(*args):
     return subprocess.run([sys.executable, "-m", "gyro", *args], capture_output=True, text=True)
 

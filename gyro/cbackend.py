@@ -243,7 +243,7 @@ def qep_refine(model_name: str) -> QepRefine:
 
 class QepHermitian:
     """The generated Hermitian form of a diagonal block of the operator (templates/qep.c.j2;
-    gyro.ladder._hermitian_block's matrix T, in C)."""
+    gyro.qep.hermitian_block's matrix T, in C)."""
 
     def __init__(self, model_name: str):
         self._fn = _entry(model_name, f"{model_name}_qep_hermitian_batch")

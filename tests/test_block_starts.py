@@ -88,3 +88,35 @@ def test_damping_or_broken_symmetry_goes_to_the_general_rung(operators_spread, p
         herm, w, z = qep.block_starts(MODEL, M, D, K, np.ones(4, bool))
     assert not herm.any() and w.shape == (0, M.shape[-1])
 
+
+
+def test_compiled_hermitian_forms_lane_by_lane(operators_spread):
+    """The generated Hermitian block forms (eight sets at a time in lanes): the eigenvalues
+    of each T are the NumPy path's 1/w; a set whose block K or M is not positive definite
+    (a negative diagonal, a pivot below the margin, a NaN) is refused and leaves the other
+    sets of its group of eight to the bit as each gets alone, also in a short last group."""
+    _, M, D, K, _ = operators_spread
+    M, D, K = M[:11].copy(), D[:11].copy(), K[:11].copy()
+    kern = cbackend.qep_hermitian(MODEL.name)
+    for b in qep.blocks(MODEL):
+        T, ok = kern(M, D, K, b)
+        assert ok.all()
+        sub = np.ix_(b, b)
+        w = qep.hermitian_block(M[:, b][:, :, b], D[:, b][:, :, b], K[:, b][:, :, b])
+        mu = np.linalg.eigvalsh(T)[:, len(b):]
+        np.testing.assert_allclose(1 / mu, w, rtol=1e-12)
+        Mx, Kx = M.copy(), K.copy()
+        i, j = b[0], b[1]
+        Kx[2][i, i] = -Kx[2][i, i]  # a negative diagonal
+        Kb = Kx[5][sub]  # a pivot below 1e3 eps: K's block made singular to rounding
+        Kb[1, :] = Kb[0, :] * np.sqrt(Kb[1, 1] / Kb[0, 0])
+        Kb[:, 1] = Kb[1, :]
+        Kx[5][sub] = Kb
+        Mx[9][i, j] = Mx[9][j, i] = np.nan
+        T2, ok2 = kern(Mx, D, Kx, b)
+        assert ok2.tolist() == [k not in (2, 5, 9) for k in range(11)]
+        assert not T2[~ok2].any()
+        for k in np.flatnonzero(ok2):
+            Tk, okk = kern(Mx[k:k + 1], D[k:k + 1], Kx[k:k + 1], b)
+            assert okk[0] and np.array_equal(Tk[0].view(float), T2[k].view(float))
+            assert np.array_equal(T[k].view(float), T2[k].view(float))

@@ -424,6 +424,52 @@ def _operator_dim(functions: list[Function]) -> int:
     return n if n >= 2 else 0
 
 
+def _real_form(functions: list[Function]) -> list[int] | None:
+    """The operator's real form, when its structure has one: a split of the coordinates into
+    two groups (0 and 1 per coordinate) with M and K coupling only coordinates of one group
+    and D only coordinates of different groups (no structural nonzero of M or K across the
+    groups, none of D within one). Then T = diag(1 on group 0, i on group 1) turns
+    J(i w) = K - w^2 M + i w D into the real symmetric T^H J T = K - w^2 M + w S D
+    (S D: D with the sign -1 from group 0 to group 1, +1 from 1 to 0) wherever M, K are
+    symmetric and D skew: the refinement's LU factors a real matrix. The split is read from
+    the patterns of M, K and D's skew part (a damping on D's diagonal vanishes where the
+    Hermitian forms hold; the runtime tests each set's whole structure). None where no split
+    exists (an odd cycle of couplings)."""
+    fn = next((f for f in functions if f.name == "operator"), None)
+    if fn is None:
+        return None
+    mats = {name: sp.Matrix(mat) for name, mat in fn.outputs}
+    if set(mats) != {"M", "D", "K"}:
+        return None
+    n = mats["M"].rows
+    D = mats["D"]
+    # D's skew (gyroscopic) part: its symmetric (damping) part must vanish for the Hermitian
+    # forms anyway, which the runtime tests set by set, as it tests the whole structure
+    patterns = (("M", mats["M"], 0), ("K", mats["K"], 0),
+                ("D", sp.Matrix(n, n, lambda i, j: sp.expand(D[i, j] - D[j, i])), 1))
+    edges = [[] for _ in range(n)]  # (neighbour, 0: same group, 1: the other group)
+    for _, mat, parity in patterns:
+        for i in range(n):
+            for j in range(n):
+                if mat[i, j] != 0:
+                    edges[i].append((j, parity))
+    group: list[int | None] = [None] * n
+    for root in range(n):
+        if group[root] is not None:
+            continue
+        group[root], stack = 0, [root]
+        while stack:
+            i = stack.pop()
+            for j, parity in edges[i]:
+                want = group[i] ^ parity
+                if group[j] is None:
+                    group[j] = want
+                    stack.append(j)
+                elif group[j] != want:
+                    return None
+    return group
+
+
 def _mode_select(functions: list[Function]) -> dict | None:
     """Shape of the model's mode formulas (modes, candidates, parameters), when it has them:
     the C then also selects and sorts them (templates/mode_select.c.j2)."""
@@ -519,6 +565,7 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
     source = _shown(module_file)
     common = dict(model=model.name, title=model.title, paper=model.source, source=source,
                   digest=digest, versions=tool_versions(), prefix=model.name, qep_n=_operator_dim(functions),
+                  real_form=_real_form(functions),
                   select=_mode_select(functions))
     if common["select"]:
         common["select"]["lanes"] = _lanes(next(f for f in emitted["c"] if f.name == "mode_formulas"))

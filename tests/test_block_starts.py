@@ -120,3 +120,73 @@ def test_compiled_hermitian_forms_lane_by_lane(operators_spread):
             Tk, okk = kern(Mx[k:k + 1], D[k:k + 1], Kx[k:k + 1], b)
             assert okk[0] and np.array_equal(Tk[0].view(float), T2[k].view(float))
             assert np.array_equal(T[k].view(float), T2[k].view(float))
+
+
+def test_the_real_form_split_of_the_torsion_operator():
+    """derive.emit._real_form: M and K couple coordinates of one group only, D (its skew
+    part) coordinates of different groups only, on the derived operator; an odd cycle of
+    couplings has no split."""
+    import sympy as sp
+
+    from derive.emit import _real_form
+    from derive.model import Function
+
+    _, M, D, K, _ = _spread_sample()
+    group = np.array([0, 1, 0, 0, 1, 0, 1, 0, 1, 1])  # what the emitter found (the C's table)
+    src = (MODEL.directory / f"{MODEL.name}.c").read_text()
+    assert "qep_group[10] = {" + ", ".join(map(str, group)) + "}" in src
+    same = group[:, None] == group[None, :]
+    assert not np.any(M[:, ~same]) and not np.any(K[:, ~same]) and not np.any(D[:, same])
+    a, b, c = sp.symbols("a b c")
+    ring = sp.Matrix([[0, a, -b], [-a, 0, c], [b, -c, 0]])  # D couples 0-1, 1-2, 2-0: odd
+    assert _real_form([Function("operator", [("p", [a, b, c])],
+                                [("M", sp.eye(3)), ("D", ring), ("K", sp.eye(3))], "")]) is None
+    chain = sp.Matrix([[c, a, 0], [-a, 0, b], [0, -b, 0]])  # a damping c on the diagonal: no matter
+    assert _real_form([Function("operator", [("p", [a, b, c])],
+                                [("M", sp.eye(3)), ("D", chain), ("K", sp.eye(3))], "")]) == [0, 1, 0]
+
+
+def _spread_sample():
+    rng = np.random.default_rng(7)
+    p0 = MODEL.vector(MODEL.defaults)
+    P = np.tile(p0, (11, 1))
+    P[:, MODEL.param_names.index("H")] *= np.geomspace(0.1, 10, 11)
+    P[:, MODEL.param_names.index("phi")] = rng.uniform(1, 89, 11)
+    qe, ok = equilibria(MODEL, P)
+    M, D, K = operators(MODEL, P, qe)
+    return P, M, D, K, ok
+
+
+def test_a_set_off_the_real_form_is_refined_by_the_complex_steps():
+    """A set whose K couples the two groups (symmetric, D still skew: the Hermitian forms
+    hold, the real form does not) is taken by the complex steps, in the starts and in the
+    refinement: its roots are those of its companion matrix, and its group's other sets keep
+    their answers to the bit."""
+    _, M, D, K, ok = _spread_sample()
+    Kx = K.copy()
+    Kx[4, 0, 1] = Kx[4, 1, 0] = 1e-3 * np.sqrt(K[4, 0, 0] * K[4, 1, 1])  # across the groups
+    Kx[9, 5, 6] = Kx[9, 6, 5] = 1e-2 * np.sqrt(K[9, 5, 5] * K[9, 6, 6])
+    outs = []
+    for KK in (K, Kx):
+        herm, w0, z0 = qep.block_starts(MODEL, M, D, KK, ok)
+        assert herm.all()
+        w, _, est, good = qep.rayleigh(MODEL, M, D, KK, w0, z0, 3, ladder.DEFAULT_TOL)
+        assert good.all() and np.all(est <= ladder.DEFAULT_TOL)
+        outs.append((w0, w, est))
+    for k in (4, 9):
+        lam = np.linalg.eigvals(qep.companion_matrix(M[k], D[k], Kx[k]))
+        exact = np.sort(np.abs(lam.imag[lam.imag > 0]))
+        np.testing.assert_allclose(np.sort(outs[1][1][k]), exact, rtol=1e-9)
+        assert not np.allclose(np.sort(outs[0][1][k]), exact, rtol=1e-9, atol=0)  # the coupling counts
+    rest = [k for k in range(11) if k not in (4, 9)]
+    for a, b in zip(outs[0], outs[1]):
+        assert np.array_equal(a[rest], b[rest])
+    # one step is the complex step (a step of the real form on this set would solve another
+    # system: its estimate would send it on, but its first step would not be this one)
+    w0 = outs[1][0] * (1 + 1e-6)
+    z0 = qep.start_vectors(*w0.shape, w0.shape[1])
+    wc, _, ec, okc = cbackend.qep_refine(MODEL.name)(M, D, Kx, w0, z0, 1, 0.0)
+    wn, _, en, okn = qep.rayleigh_step(M, D, Kx, w0, np.array(z0))
+    assert okc.all() and okn.all()
+    np.testing.assert_allclose(wc, wn, rtol=1e-12)
+    np.testing.assert_allclose(ec, en, rtol=1e-3)

@@ -427,13 +427,13 @@ def _operator_dim(functions: list[Function]) -> int:
 def _newton(functions: list[EmittedFunction], metadata: dict) -> dict | None:
     """Shape of the model's equilibrium Newton iteration (templates/equilibrium.c.j2), when
     its C can do what gyro.equilibrium does: a residual and an operator that both take
-    (params, qe) alone, qe the equilibrium coordinates, the residual a dense vector over the
-    reduced coordinates and K a dense square over them. None otherwise (the runtime then
-    takes its NumPy iteration)."""
+    (params, qe) alone, qe the equilibrium coordinates, each one of the reduced coordinates,
+    the residual a dense vector over these and K a dense square over them. None otherwise
+    (the runtime then takes its NumPy iteration)."""
     fns = {f.name: f for f in functions}
     res, op = fns.get("equilibrium_residual"), fns.get("operator")
     names, reduced = list(metadata.get("equilibrium_coordinates", [])), list(metadata.get("reduced", []))
-    if res is None or op is None or not names:
+    if res is None or op is None or not names or not set(names) <= set(reduced):
         return None
     lens = [len(i.symbols) for i in res.inputs]
     if len(lens) != 2 or [len(i.symbols) for i in op.inputs] != lens or lens[1] != len(names):

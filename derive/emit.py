@@ -470,6 +470,31 @@ def _real_form(functions: list[Function]) -> list[int] | None:
     return group
 
 
+def _newton(functions: list[EmittedFunction], metadata: dict) -> dict | None:
+    """Shape of the model's equilibrium Newton iteration (templates/equilibrium.c.j2), when
+    its C can do what gyro.equilibrium does: a residual and an operator that both take
+    (params, qe) alone, qe the equilibrium coordinates, each one of the reduced coordinates,
+    the residual a dense vector over these and K a dense square over them. None otherwise
+    (the runtime then takes its NumPy iteration)."""
+    fns = {f.name: f for f in functions}
+    res, op = fns.get("equilibrium_residual"), fns.get("operator")
+    names, reduced = list(metadata.get("equilibrium_coordinates", [])), list(metadata.get("reduced", []))
+    if res is None or op is None or not names or not set(names) <= set(reduced):
+        return None
+    lens = [len(i.symbols) for i in res.inputs]
+    if len(lens) != 2 or [len(i.symbols) for i in op.inputs] != lens or lens[1] != len(names):
+        return None
+    outs = {o.name: o for o in op.outputs}
+    nr = len(reduced)
+    if (len(res.outputs) != 1 or res.outputs[0].sparse or res.outputs[0].size != nr or "K" not in outs
+            or outs["K"].sparse or (outs["K"].rows, outs["K"].cols) != (nr, nr)):
+        return None
+    units = metadata.get("coordinate_units", {})
+    return {"ne": len(names), "idx": [reduced.index(c) for c in names], "nr": nr, "nk": nr,
+            "angle": [int(units.get(c) == "rad") for c in names], "n_params": lens[0],
+            "op_outputs": [(o.name, o.size) for o in op.outputs]}
+
+
 def _mode_select(functions: list[Function]) -> dict | None:
     """Shape of the model's mode formulas (modes, candidates, parameters), when it has them:
     the C then also selects and sorts them (templates/mode_select.c.j2)."""
@@ -567,6 +592,7 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
                   digest=digest, versions=tool_versions(), prefix=model.name, qep_n=_operator_dim(functions),
                   real_form=_real_form(functions),
                   select=_mode_select(functions))
+    common["newton"] = _newton(emitted["c"], metadata)
     if common["select"]:
         common["select"]["lanes"] = _lanes(next(f for f in emitted["c"] if f.name == "mode_formulas"))
     files = {

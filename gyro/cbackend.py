@@ -303,6 +303,41 @@ def qep_block_starts(model_name: str) -> QepBlockStarts:
     return _built(QepBlockStarts, model_name)
 
 
+class EquilibriumNewton:
+    """The generated Newton iteration of the relative equilibria (templates/equilibrium.c.j2;
+    gyro.equilibrium._newton_numpy set by set, in C)."""
+
+    CONVERGED, HANDED_BACK = 1, 2
+
+    def __init__(self, model_name: str):
+        self._fn = _entry(model_name, f"{model_name}_equilibrium_newton_batch")
+        meta = load(model_name).meta
+        self.n_params = len(meta["functions"]["equilibrium_residual"]["inputs"][0]["symbols"])
+        self.n = len(meta["equilibrium_coordinates"])
+
+    def __call__(self, P, qe, tol: float, max_iter: int, max_angle_step: float):
+        """P (sets, parameters); qe (sets, equilibrium coordinates) the starts. Returns new
+        arrays (qe, status): status per set CONVERGED (qe the last iterate) or HANDED_BACK
+        (qe not to be used: an entry of r or K not below 1e150, a zero pivot, a step or an
+        iterate not finite, no convergence in max_iter steps; the NumPy iteration answers
+        that set)."""
+        P = np.ascontiguousarray(P, dtype=float)
+        qe = np.array(qe, dtype=float, order="C")  # a copy: the C iterates in place
+        _check(P.ndim == 2 and P.shape[1] == self.n_params and qe.shape == (P.shape[0], self.n),
+               f"params must be (sets, {self.n_params}) and qe (sets, {self.n})")
+        status = np.empty(P.shape[0], dtype=np.dtype(ctypes.c_long))
+        ptr = ctypes.POINTER(ctypes.c_double)
+        self._fn(ctypes.c_long(P.shape[0]), ctypes.c_long(max_iter), ctypes.c_double(tol),
+                 ctypes.c_double(max_angle_step), P.ctypes.data_as(ptr), qe.ctypes.data_as(ptr),
+                 status.ctypes.data_as(ctypes.POINTER(ctypes.c_long)))
+        return qe, status
+
+
+def equilibrium_newton(model_name: str) -> EquilibriumNewton:
+    """The compiled equilibrium Newton iteration of a model (CompilerUnavailable when its C has none)."""
+    return _built(EquilibriumNewton, model_name)
+
+
 _HUGE = 2 << 20  # bytes of a transparent huge page (x86-64, arm64 with 4 kB pages)
 _MADV_HUGEPAGE = 14
 

@@ -8,13 +8,16 @@ free); a set that has not converged after MAX_ITER steps is accepted when its re
 below 1e-9 (1 + max |p|), as an exact but ill-conditioned equilibrium is; the equation of
 a steadily turning coordinate, which no unknown enters, must hold to the same bound (a
 drive balancing friction at these parameters) or the set has no reference motion; inputs
-whose operator is beyond double precision never reach LAPACK."""
+whose operator is beyond double precision never reach LAPACK. With a compiler the iteration
+runs in the generated C set by set (templates/equilibrium.c.j2), which answers the sets it
+converges on and hands every other back to the NumPy iteration (_newton_numpy)."""
 from __future__ import annotations
 
 import numpy as np
 
+from gyro import cbackend
 from gyro.errors import ParameterError
-from gyro.kernels import function
+from gyro.kernels import compiled, function
 from gyro.models import Model
 
 
@@ -78,6 +81,48 @@ def equilibria(model: Model, P: np.ndarray, tol: float = TOL, max_iter: int = MA
         qe = np.where(np.isfinite(qe), qe, 0.0)  # (2.2) divides by g: at g = 0 start from zero
     else:
         qe = np.zeros((n, len(names)))
+    qe, converged = _newton(model, P, qe, idx, is_angle, tol, max_iter)
+    resid = function(model, "equilibrium_residual")
+    ok = np.all(np.isfinite(qe), axis=1) & converged
+    late = np.flatnonzero(~converged & np.all(np.isfinite(qe), axis=1))
+    if late.size:  # not converged in max_iter: an exact equilibrium that Newton circles
+        with np.errstate(all="ignore"):
+            r = resid(P[late], qe[late])[0].reshape(late.size, -1)[:, idx]
+        ok[late] = np.max(np.abs(r), axis=1, initial=0.0) <= 1e-9 * (1 + np.max(np.abs(P[late]), axis=1))
+    steady = [model.meta["reduced"].index(c) for c in model.meta.get("steady", {})]
+    if steady and ok.any():  # a steady coordinate's row: no unknown enters it, it must hold itself
+        k = np.flatnonzero(ok)
+        with np.errstate(all="ignore"):
+            r = resid(P[k], qe[k])[0].reshape(k.size, -1)[:, steady]
+        ok[k] = np.max(np.abs(r), axis=1) <= 1e-9 * (1 + np.max(np.abs(P[k]), axis=1))
+    qe = np.where(is_angle, wrap(qe), qe)
+    qe[~ok] = np.nan
+    return qe, ok
+
+
+def _newton(model: Model, P, qe, idx, is_angle, tol, max_iter):
+    """The Newton iteration from the starts qe: the generated C set by set where there is a
+    compiler, answering the sets it converges on; each set it hands back (an entry of r or K
+    not below 1e150, a zero pivot, a step or an iterate not finite, no convergence in
+    max_iter steps: where the outcome hangs on the rounding of the solve, or the NumPy
+    iteration does otherwise) answered by _newton_numpy from its start; _newton_numpy alone
+    without a compiler. Returns (qe, converged): qe NaN where an iterate was not finite."""
+    kernel = compiled(cbackend.equilibrium_newton, model)
+    if kernel is None:
+        return _newton_numpy(model, P, qe.copy(), idx, is_angle, tol, max_iter)
+    out, status = kernel(P, qe, tol, max_iter, MAX_ANGLE_STEP)
+    converged = status == kernel.CONVERGED
+    back = np.flatnonzero(~converged)
+    if back.size:
+        out[back], converged[back] = _newton_numpy(model, P[back], qe[back], idx, is_angle, tol, max_iter)
+    return out, converged
+
+
+def _newton_numpy(model: Model, P, qe, idx, is_angle, tol, max_iter):
+    """The Newton iteration vectorised over the batch, qe (the starts) iterated in place:
+    a set whose r or K is not below 1e150 takes a NaN step (it fails), and where any K of the
+    batch is singular every set of that step takes least squares. Returns (qe, converged)."""
+    n = P.shape[0]
     resid, oper = function(model, "equilibrium_residual"), function(model, "operator")
     active = np.ones(n, bool)
     converged = np.zeros(n, bool)
@@ -105,21 +150,7 @@ def equilibria(model: Model, P: np.ndarray, tol: float = TOL, max_iter: int = MA
         converged[a[conv & ~bad]] = True
         active[a[conv | bad]] = False
         qe[a[bad]] = np.nan
-    ok = np.all(np.isfinite(qe), axis=1) & converged
-    late = np.flatnonzero(~converged & np.all(np.isfinite(qe), axis=1))
-    if late.size:  # not converged in max_iter: an exact equilibrium that Newton circles
-        with np.errstate(all="ignore"):
-            r = resid(P[late], qe[late])[0].reshape(late.size, -1)[:, idx]
-        ok[late] = np.max(np.abs(r), axis=1, initial=0.0) <= 1e-9 * (1 + np.max(np.abs(P[late]), axis=1))
-    steady = [model.meta["reduced"].index(c) for c in model.meta.get("steady", {})]
-    if steady and ok.any():  # a steady coordinate's row: no unknown enters it, it must hold itself
-        k = np.flatnonzero(ok)
-        with np.errstate(all="ignore"):
-            r = resid(P[k], qe[k])[0].reshape(k.size, -1)[:, steady]
-        ok[k] = np.max(np.abs(r), axis=1) <= 1e-9 * (1 + np.max(np.abs(P[k]), axis=1))
-    qe = np.where(is_angle, wrap(qe), qe)
-    qe[~ok] = np.nan
-    return qe, ok
+    return qe, converged
 
 
 def equilibrium(model: Model, params) -> np.ndarray:

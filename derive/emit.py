@@ -186,9 +186,11 @@ class EmittedFunction:
     outputs: list[Output]
     ops: int  # operations after CSE
     ops_before: int  # operations before CSE
-    # the C statements in their order (_schedule): (temporary name, None, expression) or
-    # (output name, position in the emitted array, expression)
+    # the C statements in their order (_schedule): (temporary or input symbol, None,
+    # expression) or (output name, position in the emitted array, expression); an input is
+    # read just before the first statement that needs it (_reads)
     body: list = ()
+    unread: list = ()  # the inputs of which the C reads no entry
 
 
 def _cse(fn: Function):
@@ -254,20 +256,44 @@ def _printed(fn, temps, reduced, ops, ops_before, printer, schedule=None) -> Emi
                            vector=mat.cols == 1 and name not in fn.matrices, sparse=name in fn.sparse))
         k += mat.rows * mat.cols
     printed_temps = [(str(t), printer.doprint(e)) for t, e in temps]
-    body = []
+    body, unread = [], {n for n, _ in fn.inputs}
     if schedule is not None:  # flat entry k -> (output name, position in its emitted array)
         where, k = {}, 0
         for o in outs:
             for pos, (idx, e) in enumerate(o.entries):
                 where[k + idx] = (o.name, pos if o.sparse else idx, e)
             k += o.rows * o.cols
-        body = [(printed_temps[i][0], None, printed_temps[i][1]) if kind == "t" else where[i]
-                for kind, i in schedule]
+        read = {s: (n, j) for n, syms in fn.inputs for j, s in enumerate(syms)}
+        for kind, i in _reads(schedule, temps, reduced, read):
+            if kind == "i":
+                n, j = read[i]
+                body.append((str(i), None, f"{n}[{j}]"))
+                unread.discard(n)
+            else:
+                body.append((printed_temps[i][0], None, printed_temps[i][1]) if kind == "t" else where[i])
     return EmittedFunction(
         name=fn.name, doc=fn.doc,
         inputs=[Input(n, [str(s) for s in syms]) for n, syms in fn.inputs],
         temps=printed_temps,
-        outputs=outs, ops=int(ops), ops_before=int(ops_before), body=body)
+        outputs=outs, ops=int(ops), ops_before=int(ops_before), body=body,
+        unread=[n for n, _ in fn.inputs if n in unread])
+
+
+def _reads(schedule, temps, reduced, inputs) -> list:
+    """The schedule with ("i", symbol) for each input symbol it uses, just before the first
+    statement that needs it: a value read from the input array where it is used, not all
+    of them at the top, where the compiler loaded every one at the start and kept them live
+    across the calls to sin and cos (spilled to the stack and back); the statements and
+    their values are the schedule's. The C then reads an input after it has stored into an
+    output: the outputs must not overlap the inputs (the contract in model.h.j2)."""
+    out, seen = [], set()
+    for kind, i in schedule:
+        e = temps[i][1] if kind == "t" else reduced[i]
+        for s in sorted((s for s in e.free_symbols if s in inputs and s not in seen), key=inputs.get):
+            seen.add(s)
+            out.append(("i", s))
+        out.append((kind, i))
+    return out
 
 
 # --------------------------------------------------------------------------- files

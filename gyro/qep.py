@@ -429,7 +429,8 @@ def block_vectors(M, D, K, w, blocks_, rhs):
 
 
 def block_starts(model: Model, M, D, K, good):
-    """Which sets take the Hermitian path (gyroscopic: M, K symmetric and D skew; K > 0 and
+    """Which sets take the Hermitian path (gyroscopic: M, K symmetric and D skew, every
+    entry far from overflow as gyro.equilibrium.tame has it; K > 0 and
     M > 0 in every diagonal block, with a margin) and, for those, the block problems' frequencies (sets taken, n) and a vector
     per root (sets taken, n, n): the starts of the refinement. Compiled: the model's
     generated block forms and their eigenvalues without LAPACK (templates/qep_starts.c.j2),
@@ -447,7 +448,8 @@ def block_starts(model: Model, M, D, K, good):
         h = np.flatnonzero(herm)
         return herm, w[h], z[h]
     dK, dM = np.einsum("bii->bi", K), np.einsum("bii->bi", M)
-    herm = good & np.all(dK > 0, axis=1) & np.all(dM > 0, axis=1) & gyroscopic(M, D, K)
+    herm = (good & np.all(dK > 0, axis=1) & np.all(dM > 0, axis=1) & gyroscopic(M, D, K)
+            & tame(M) & tame(D) & tame(K))
     for b in blocks_:
         for X, d in ((K, dK), (M, dM)):
             with np.errstate(all="ignore"):

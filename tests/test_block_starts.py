@@ -190,3 +190,22 @@ def test_a_set_off_the_real_form_is_refined_by_the_complex_steps():
     assert okc.all() and okn.all()
     np.testing.assert_allclose(wc, wn, rtol=1e-12)
     np.testing.assert_allclose(ec, en, rtol=1e-3)
+
+
+@pytest.mark.parametrize("path", ["compiled", "numpy"])
+def test_sets_near_overflow_go_to_the_general_rung(operators_spread, path):
+    """An entry of M, D or K at or above 1e150 in magnitude (gyro.equilibrium.tame), or a
+    NaN, keeps a set off the structured rung on either path, symmetry kept; its company
+    keeps its starts to the bit."""
+    _, M, D, K, ok = operators_spread
+    M, D, K = M[:10].copy(), D[:10].copy(), K[:10].copy()
+    M[1, 0, 0] = 1e150
+    K[3, 0, 2] = K[3, 2, 0] = -1e151
+    D[5, 0, 1], D[5, 1, 0] = 1e150, -1e150
+    K[7, 1, 1] = np.nan
+    with cbackend.disabled() if path == "numpy" else nullcontext():
+        herm, w, z = qep.block_starts(MODEL, M, D, K, np.ones(10, bool))
+        assert herm.tolist() == [k not in (1, 3, 5, 7) for k in range(10)]
+        keep = np.flatnonzero(herm)
+        h2, w2, z2 = qep.block_starts(MODEL, M[keep], D[keep], K[keep], np.ones(keep.size, bool))
+    assert h2.all() and np.array_equal(w, w2) and np.array_equal(z, z2)

@@ -42,12 +42,15 @@ def solve(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
     freq = np.full((N, n), np.nan)
     growth = np.zeros((N, n))
     est = np.full((N, n), np.inf)
-    good = ok & tame(M) & tame(D) & tame(K)
+    # the structured path assumes a conservative gyroscopic operator (M, K symmetric, D skew
+    # to the bit) far from overflow (tame); block_starts hands any other set (bearing
+    # damping) to the general rung, which takes the sets tame among them
+    herm, w0, z0 = qep.block_starts(model, M, D, K, ok)
+    good = herm.copy()
+    rest = np.flatnonzero(ok & ~herm)
+    good[rest] = tame(M[rest]) & tame(D[rest]) & tame(K[rest])
     # which rung answered; "none" where no rung could (no equilibrium in any precision)
     route = np.where(good, "structured", "none").astype(object)
-    # the structured path assumes a conservative gyroscopic operator (M, K symmetric, D skew
-    # to the bit); block_starts hands any other set (bearing damping) to the general rung
-    herm, w0, z0 = qep.block_starts(model, M, D, K, good)
     h = np.flatnonzero(herm)
     if h.size:
         take = slice(None) if h.size == N else h

@@ -7,6 +7,7 @@ import functools
 import json
 import os
 import random
+import shutil
 import subprocess
 import sys
 
@@ -368,3 +369,18 @@ def test_c_printer_parenthesises_powers_in_denominators():
         got = eval(pr.doprint(e), vals)
         want = float(e.subs({x: 1.7, y: 0.3, z: 2.9}))
         assert abs(got / want - 1) < 1e-14, (e, pr.doprint(e))
+
+
+@pytest.mark.parametrize("name", [m for m in MODELS if "QEP_N" in (GENERATED / m / f"{m}.c").read_text()])
+def test_c_compiles_without_warnings_under_the_runtime_flags(name, tmp_path):
+    """The runtime's own flags (gyro.cbackend.FLAGS: -O3 -march=native, where the compiler
+    sees the lanes as this machine's vectors and warns of what it cannot prove initialised)
+    with -Wall -Wextra -Werror -pedantic: a user building with warnings as errors builds."""
+    from gyro import cbackend
+
+    cc = shutil.which("gcc") or shutil.which("cc")
+    src = GENERATED / name / f"{name}.c"
+    cmd = [cc, *cbackend.FLAGS, "-Wall", "-Wextra", "-Werror", "-pedantic", "-I", str(src.parent),
+           str(src), "-o", str(tmp_path / f"{name}.so"), "-lm"]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr[:2000]

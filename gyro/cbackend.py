@@ -221,14 +221,19 @@ class QepRefine:
         self._fn = _entry(model_name, f"{model_name}_qep_refine_batch")
         self.n = _operator_dim(model_name)
 
-    def __call__(self, M, D, K, w, z, iters: int, tol: float):
+    def __call__(self, M, D, K, w, z, iters: int, tol: float, overwrite: bool = False):
         """M, D, K (sets, n, n); w (sets, r) and z (sets, r, n) complex: the starts. Returns
-        new arrays (w, z, estimate, ok)."""
+        new arrays (w, z, estimate, ok); with overwrite, w and z themselves refined in place
+        where they are already C-contiguous arrays of their dtype and shape (the caller's
+        starts are then gone)."""
         M, D, K = (np.ascontiguousarray(X, dtype=float) for X in (M, D, K))
-        w = np.array(w, dtype=float, order="C")
+        w = np.require(w, float, "C") if overwrite else np.array(w, dtype=float, order="C")
         _check(all(X.shape == (w.shape[0], self.n, self.n) for X in (M, D, K)) and w.ndim == 2,
                f"M, D, K must be (sets, {self.n}, {self.n}) and w (sets, roots)")
-        z = np.array(np.broadcast_to(z, w.shape + (self.n,)), dtype=complex, order="C")
+        shape = w.shape + (self.n,)
+        if not (overwrite and isinstance(z, np.ndarray) and z.shape == shape and z.dtype == complex
+                and z.flags.c_contiguous and z.flags.writeable):
+            z = np.array(np.broadcast_to(z, shape), dtype=complex, order="C")
         est, ok = np.empty(w.shape), np.empty(w.shape)
         ptr = ctypes.POINTER(ctypes.c_double)
         self._fn(ctypes.c_long(w.shape[0]), ctypes.c_long(w.shape[1]), ctypes.c_long(iters),

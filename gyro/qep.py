@@ -282,14 +282,16 @@ def rayleigh_step(M, D, K, w, z):
     return wn, zn, est, ok
 
 
-def rayleigh(model: Model, M, D, K, w, z, iters, tol, chunk=256):
+def rayleigh(model: Model, M, D, K, w, z, iters, tol, chunk=256, overwrite=False):
     """Steps of rayleigh_step on every root until its estimate is <= tol (at most `iters`).
-    Compiled: the model's generated refinement (templates/qep.c.j2), root by root. Without
-    a compiler: rayleigh_step on every root, in chunks of sets (cache-sized), then further
-    steps only on the roots whose estimate still exceeds tol. Returns (w, z, estimate, ok)."""
+    Compiled: the model's generated refinement (templates/qep.c.j2), root by root (with
+    overwrite, in the caller's w and z where their layout allows: no copy of the vectors).
+    Without a compiler: rayleigh_step on every root, in chunks of sets (cache-sized), then
+    further steps only on the roots whose estimate still exceeds tol. Returns (w, z,
+    estimate, ok)."""
     kernel = compiled(cbackend.qep_refine, model)
     if kernel is not None:
-        return kernel(M, D, K, w, z, iters, tol)
+        return kernel(M, D, K, w, z, iters, tol, overwrite=overwrite)
     N = M.shape[0]
     w, z = w.copy(), np.array(np.broadcast_to(z, w.shape + (M.shape[-1],)), dtype=complex)
     est = np.full(w.shape, np.inf)

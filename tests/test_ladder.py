@@ -477,6 +477,33 @@ def test_refinement_steps_agree_root_by_root():
     np.testing.assert_allclose(ec, en, rtol=1e-3)
 
 
+def test_refinement_in_place_gives_the_same_answers():
+    """With overwrite the compiled refinement works in the caller's w and z (no copy of
+    the vectors) and answers to the bit as with copies; a z it cannot use as it is (a
+    broadcast start, another dtype) is copied as before, the caller's array untouched."""
+    from gyro.cbackend import qep_refine
+
+    P = np.array([params(), params(phi=60.0), params(H=0.1)])
+    qe, _ = equilibria(MODEL, P)
+    M, D, K = operators(MODEL, P, qe)
+    n = M.shape[-1]
+    w0 = np.sort(np.abs(ladder.spectrum(MODEL, P, "companion").frequencies), axis=1) * (1 + 1e-6)
+    z0 = np.array(qep.start_vectors(len(P), n, n))
+    refine = qep_refine(MODEL.name)
+    ref = refine(M, D, K, w0, z0, 3, ladder.DEFAULT_TOL)
+    w1, z1 = w0.copy(), z0.copy()
+    got = refine(M, D, K, w1, z1, 3, ladder.DEFAULT_TOL, overwrite=True)
+    assert got[0] is w1 and got[1] is z1
+    for a, b in zip(ref, got):
+        assert np.array_equal(a, b)
+    shared = qep.start_vectors(len(P), n, n)  # read-only broadcast: copied
+    z2 = z0.astype(np.complex64)
+    for z in (shared, z2):
+        before = np.array(z)
+        got = refine(M, D, K, w0.copy(), z, 3, ladder.DEFAULT_TOL, overwrite=True)
+        assert got[1] is not z and np.array_equal(np.array(z), before)
+
+
 def test_a_lane_whose_step_fails_is_taken_again_by_the_pivoted_steps():
     """A start on a root to the last bit makes J(i w) exactly singular (here a zero row: M = I,
     D = 0, K = diag(k^2), w = 1): that lane's step in the compiled refinement fails, and the

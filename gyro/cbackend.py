@@ -224,10 +224,10 @@ class QepRefine:
     def __call__(self, M, D, K, w, z, iters: int, tol: float, overwrite: bool = False):
         """M, D, K (sets, n, n); w (sets, r) and z (sets, r, n) complex: the starts. Returns
         new arrays (w, z, estimate, ok); with overwrite, w and z themselves refined in place
-        where they are already C-contiguous arrays of their dtype and shape (the caller's
-        starts are then gone)."""
+        where they are already writeable C-contiguous arrays of their dtype and shape (the
+        caller's starts are then gone), copies otherwise."""
         M, D, K = (np.ascontiguousarray(X, dtype=float) for X in (M, D, K))
-        w = np.require(w, float, "C") if overwrite else np.array(w, dtype=float, order="C")
+        w = np.require(w, float, "CW") if overwrite else np.array(w, dtype=float, order="C")
         _check(all(X.shape == (w.shape[0], self.n, self.n) for X in (M, D, K)) and w.ndim == 2,
                f"M, D, K must be (sets, {self.n}, {self.n}) and w (sets, roots)")
         shape = w.shape + (self.n,)

@@ -209,3 +209,20 @@ def test_sets_near_overflow_go_to_the_general_rung(operators_spread, path):
         keep = np.flatnonzero(herm)
         h2, w2, z2 = qep.block_starts(MODEL, M[keep], D[keep], K[keep], np.ones(keep.size, bool))
     assert h2.all() and np.array_equal(w, w2) and np.array_equal(z, z2)
+
+
+def test_a_set_off_the_real_form_near_a_root_to_the_last_bit_is_still_taken():
+    """A coupling across the real form's groups far below rounding (1e-300) turns a block's
+    exact zero pivot at a root to the last bit (omega_p) into a tiny one: the complex solve
+    then gives no finite vector at the first shift, and the next shifts are tried, as in
+    lanes; the compiled starts take every set the NumPy starts take."""
+    from bench.speed import random_sets
+
+    P = random_sets(2000, seed=11)
+    qe, ok = equilibria(MODEL, P)
+    M, D, K = operators(MODEL, P, qe)
+    K[:, 0, 1] = K[:, 1, 0] = 1e-300
+    herm, w, _ = qep.block_starts(MODEL, M, D, K, ok)
+    hn, wn, _ = _numpy_path(M, D, K, ok)
+    assert herm.sum() > 1900 and np.array_equal(herm, hn)
+    np.testing.assert_allclose(w, wn, rtol=1e-10)

@@ -502,6 +502,10 @@ def test_refinement_in_place_gives_the_same_answers():
         before = np.array(z)
         got = refine(M, D, K, w0.copy(), z, 3, ladder.DEFAULT_TOL, overwrite=True)
         assert got[1] is not z and np.array_equal(np.array(z), before)
+    w3 = w0.copy()
+    w3.setflags(write=False)  # a read-only w: copied, not written
+    got = refine(M, D, K, w3, z0.copy(), 3, ladder.DEFAULT_TOL, overwrite=True)
+    assert got[0] is not w3 and np.array_equal(w3, w0) and np.array_equal(got[0], ref[0])
 
 
 def test_a_lane_whose_step_fails_is_taken_again_by_the_pivoted_steps():

@@ -471,10 +471,9 @@ def _real_form(functions: list[Function]) -> list[int] | None:
     D = mats["D"]
     # D's skew (gyroscopic) part: its symmetric (damping) part must vanish for the Hermitian
     # forms anyway, which the runtime tests set by set, as it tests the whole structure
-    patterns = (("M", mats["M"], 0), ("K", mats["K"], 0),
-                ("D", sp.Matrix(n, n, lambda i, j: sp.expand(D[i, j] - D[j, i])), 1))
+    patterns = ((mats["M"], 0), (mats["K"], 0), (sp.Matrix(n, n, lambda i, j: sp.expand(D[i, j] - D[j, i])), 1))
     edges = [[] for _ in range(n)]  # (neighbour, 0: same group, 1: the other group)
-    for _, mat, parity in patterns:
+    for mat, parity in patterns:
         for i in range(n):
             for j in range(n):
                 if mat[i, j] != 0:

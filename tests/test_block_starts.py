@@ -215,14 +215,15 @@ def test_a_set_off_the_real_form_near_a_root_to_the_last_bit_is_still_taken():
     """A coupling across the real form's groups far below rounding (1e-300) turns a block's
     exact zero pivot at a root to the last bit (omega_p) into a tiny one: the complex solve
     then gives no finite vector at the first shift, and the next shifts are tried, as in
-    lanes; the compiled starts take every set the NumPy starts take."""
+    lanes. A coupling that small changes nothing else: the starts take every set they take
+    without it, with the same frequencies to the bit, and so do the NumPy starts."""
     from bench.speed import random_sets
 
     P = random_sets(2000, seed=11)
     qe, ok = equilibria(MODEL, P)
     M, D, K = operators(MODEL, P, qe)
+    h0, w0, _ = qep.block_starts(MODEL, M, D, K, ok)
     K[:, 0, 1] = K[:, 1, 0] = 1e-300
     herm, w, _ = qep.block_starts(MODEL, M, D, K, ok)
-    hn, wn, _ = _numpy_path(M, D, K, ok)
-    assert herm.sum() > 1900 and np.array_equal(herm, hn)
-    np.testing.assert_allclose(w, wn, rtol=1e-10)
+    hn, _, _ = _numpy_path(M, D, K, ok)
+    assert h0.all() and herm.all() and hn.all() and np.array_equal(w, w0)

@@ -497,27 +497,25 @@ def _real_form(functions: list[Function]) -> list[int] | None:
 
 def _newton(functions: list[EmittedFunction], metadata: dict) -> dict | None:
     """Shape of the model's equilibrium Newton iteration (templates/equilibrium.c.j2), when
-    its C can do what gyro.equilibrium does: a residual and an operator that both take
-    (params, qe) alone, qe the equilibrium coordinates, each one of the reduced coordinates,
-    the residual a dense vector over these and K a dense square over them. None otherwise
-    (the runtime then takes its NumPy iteration)."""
-    fns = {f.name: f for f in functions}
-    res, op = fns.get("equilibrium_residual"), fns.get("operator")
+    its C can do what gyro.equilibrium does: an equilibrium_system (r and K at the
+    equilibrium coordinates) that takes (params, qe) alone, r a dense vector and K a dense
+    square over the equilibrium coordinates. None otherwise (the runtime then takes its NumPy
+    iteration)."""
+    system = next((f for f in functions if f.name == "equilibrium_system"), None)
     names, reduced = list(metadata.get("equilibrium_coordinates", [])), list(metadata.get("reduced", []))
-    if res is None or op is None or not names or not set(names) <= set(reduced):
+    if system is None or not names or not set(names) <= set(reduced):
         return None
-    lens = [len(i.symbols) for i in res.inputs]
-    if len(lens) != 2 or [len(i.symbols) for i in op.inputs] != lens or lens[1] != len(names):
-        return None
-    outs = {o.name: o for o in op.outputs}
-    nr = len(reduced)
-    if (len(res.outputs) != 1 or res.outputs[0].sparse or res.outputs[0].size != nr or "K" not in outs
-            or outs["K"].sparse or (outs["K"].rows, outs["K"].cols) != (nr, nr)):
+    lens = [len(i.symbols) for i in system.inputs]
+    ne = len(names)
+    outs = {o.name: o for o in system.outputs}
+    if (len(lens) != 2 or lens[1] != ne or list(outs) != ["r", "K"] or outs["r"].sparse or outs["K"].sparse
+            or outs["r"].size != ne or (outs["K"].rows, outs["K"].cols) != (ne, ne)):
         return None
     units = metadata.get("coordinate_units", {})
-    return {"ne": len(names), "idx": [reduced.index(c) for c in names], "nr": nr, "nk": nr,
-            "angle": [int(units.get(c) == "rad") for c in names], "n_params": lens[0],
-            "op_outputs": [(o.name, o.size) for o in op.outputs]}
+    key = [units.get(c) or f"#{i}" for i, c in enumerate(names)]  # as gyro.equilibrium._groups
+    return {"ne": ne, "idx": [reduced.index(c) for c in names],
+            "angle": [int(units.get(c) == "rad") for c in names],
+            "group": [key.index(k) for k in key], "n_params": lens[0]}
 
 
 def _mode_select(functions: list[Function]) -> dict | None:

@@ -68,6 +68,18 @@ def _layout(model: Model):
     return names, idx, np.array([units.get(c) == "rad" for c in names], dtype=bool)
 
 
+def _groups(model: Model) -> np.ndarray:
+    """(ne, ne) booleans: coordinates i and j of the same unit (lengths with lengths, angles
+    with angles; one without a unit alone). The iteration's convergence test measures each
+    step against the largest coordinate of its group: a coordinate at rounding noise about an
+    exact zero (the gyrohorizoncompass's beta near 1e-20 rad beside an epsilon of 1 rad) has
+    no relative precision for a test of its own to reach."""
+    names = model.meta["equilibrium_coordinates"]
+    units = model.meta.get("coordinate_units", {})
+    key = [units.get(c) or f"#{i}" for i, c in enumerate(names)]
+    return np.array([[a == b for b in key] for a in key], dtype=bool).reshape(len(key), len(key))
+
+
 def equilibria(model: Model, P: np.ndarray, tol: float = TOL, max_iter: int = MAX_ITER):
     """Relative equilibria of a batch P (sets, parameters). Returns (qe, ok): qe (sets,
     equilibrium coordinates), NaN where ok is False."""
@@ -121,9 +133,12 @@ def _newton(model: Model, P, qe, idx, is_angle, tol, max_iter):
 def _newton_numpy(model: Model, P, qe, idx, is_angle, tol, max_iter):
     """The Newton iteration vectorised over the batch, qe (the starts) iterated in place:
     a set whose r or K is not below 1e150 takes a NaN step (it fails), and where any K of the
-    batch is singular every set of that step takes least squares. Returns (qe, converged)."""
+    batch is singular every set of that step takes least squares; converged when every
+    |dq_i| <= tol max(largest |qe_j| of i's group (_groups), 1e-300) + 1e-300. Returns
+    (qe, converged)."""
     n = P.shape[0]
-    resid, oper = function(model, "equilibrium_residual"), function(model, "operator")
+    system = _system(model, idx)
+    same = _groups(model)
     active = np.ones(n, bool)
     converged = np.zeros(n, bool)
     for _ in range(max_iter):
@@ -131,8 +146,7 @@ def _newton_numpy(model: Model, P, qe, idx, is_angle, tol, max_iter):
         if a.size == 0:
             break
         with np.errstate(all="ignore"):
-            r = resid(P[a], qe[a])[0].reshape(a.size, -1)[:, idx]
-            K = oper(P[a], qe[a])[2][:, idx][:, :, idx]
+            r, K = system(P[a], qe[a])
             ok_in = tame(K) & np.all(np.abs(r) < 1e150, axis=1)
             K = np.where(ok_in[:, None, None], K, np.eye(len(idx)))
             r = np.where(ok_in[:, None], r, np.nan)
@@ -146,11 +160,26 @@ def _newton_numpy(model: Model, P, qe, idx, is_angle, tol, max_iter):
         dq *= np.minimum(1.0, MAX_ANGLE_STEP / np.maximum(big, 1e-300))[:, None]
         qe[a] += dq
         bad = ~np.all(np.isfinite(qe[a]), axis=1)
-        conv = np.all(np.abs(dq) <= tol * np.maximum(np.abs(qe[a]), 1e-300) + 1e-300, axis=1)
+        scale = np.max(np.where(same, np.abs(qe[a])[:, None, :], 0.0), axis=2, initial=0.0)  # the group's largest
+        conv = np.all(np.abs(dq) <= tol * np.maximum(scale, 1e-300) + 1e-300, axis=1)
         converged[a[conv & ~bad]] = True
         active[a[conv | bad]] = False
         qe[a[bad]] = np.nan
     return qe, converged
+
+
+def _system(model: Model, idx):
+    """(P, qe) -> (r, K) of the Newton step over the equilibrium coordinates: the model's
+    equilibrium_system; for a model generated before it existed, the residual's rows idx and
+    the operator's K restricted to them (the same values, the whole operator evaluated)."""
+    if "equilibrium_system" in model.meta["functions"]:
+        fn = function(model, "equilibrium_system")
+        ne = len(idx)
+        return lambda P, qe: tuple(np.asarray(x).reshape(P.shape[0], *s)
+                                   for x, s in zip(fn(P, qe), ((ne,), (ne, ne))))
+    resid, oper = function(model, "equilibrium_residual"), function(model, "operator")
+    return lambda P, qe: (resid(P, qe)[0].reshape(P.shape[0], -1)[:, idx],
+                          oper(P, qe)[2][:, idx][:, :, idx])
 
 
 def equilibrium(model: Model, params) -> np.ndarray:

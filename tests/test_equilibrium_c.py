@@ -2,10 +2,13 @@
 NumPy iteration it replaces (gyro.equilibrium._newton_numpy), for every model that has it.
 
 The C answers a set only where it converges; what it hands back, the NumPy iteration
-answers from the start. Against the NumPy iteration over the same generated C functions the
-answers are the same to the bit, but for a coordinate below 1e-12 of its set's largest
-(rounding noise about an exact zero, which Newton's relative test circles: the
-gyrohorizoncompass's beta near 1e-20), which agrees to eps of that largest. Against the
+answers from the start. Both measure each step against the largest coordinate of its unit
+(a coordinate at rounding noise about an exact zero, the gyrohorizoncompass's beta near
+1e-20 rad beside an epsilon of 1 rad, has no relative precision for a test of its own: the
+iterate circled in it until the test was changed, and the CSE of equilibrium_system moved
+the noise so that 56 % of that model's sets were handed back). Against the NumPy iteration
+over the same generated C functions the answers are the same to the bit, but for a
+coordinate below 1e-12 of its set's largest, which agrees to eps of that largest. Against the
 path without a compiler (the generated NumPy functions, which differ from the C in the last
 bits: up to 89 eps measured in the gyrohorizoncompass's epsilon) to 10 TOL = 1e-13 of each
 coordinate. On the torsion gyrocompass the sets agree to the bit with both."""
@@ -115,7 +118,9 @@ def test_c_and_numpy_agree_on_random_sets(name):
     model, P = load(name), random_sets(name, 3000)
     _, status = kernel_run(model, P)
     answered = status == cbackend.EquilibriumNewton.CONVERGED
-    assert answered.mean() > 0.9  # the C answers nearly all of them: the comparison is of the C
+    # the C answers nearly all of them: the comparison is of the C (measured: all but 5 of the
+    # gyrohorizoncompass's, beta alone near 1e-6 rad, which both iterations circle)
+    assert answered.mean() > 0.99
     qc, okc = equilibria(model, P)
     qn, okn = numpy_iteration(model, P)
     assert okn.all() and np.array_equal(okc, okn)
@@ -152,9 +157,13 @@ def test_one_step_of_the_c_is_one_step_of_numpy(name):
 
 def test_singular_k_is_handed_back_and_answered_as_numpy_answers():
     """No Earth rate with g = 0 (or with no torsion stiffness): K is singular at the start,
-    the NumPy iteration takes least squares. g = 0 (with or without latitude 90 deg) leaves
-    K singular in exact arithmetic only: the iteration circles the free azimuth and is
-    handed back. Latitude 90 deg alone: K regular, the C answers."""
+    the NumPy iteration takes least squares. g = 0 leaves K singular in exact arithmetic
+    only: with latitude 90 deg as well the iteration circles the free azimuth and is handed
+    back; g = 0 alone, Newton comes to rest at a point of it (K's condition about 1e16
+    there, the coordinates of the other group at rounding noise below 1e-28 of beta): the C
+    answers it, as the NumPy iteration of that set alone does (in the batch with the two
+    singular sets the NumPy iteration takes least squares and comes to another point of the
+    free azimuth). Latitude 90 deg alone: K regular, the C answers."""
     model = load("torsion_gyrocompass")
     ix = model.param_names.index
     P = np.tile(model.vector(model.defaults), (6, 1))
@@ -165,7 +174,7 @@ def test_singular_k_is_handed_back_and_answered_as_numpy_answers():
     P[4, [ix("g"), ix("phi")]] = [0.0, 90.0]
     _, status = kernel_run(model, P)
     back = status == cbackend.EquilibriumNewton.HANDED_BACK
-    assert back[[0, 1, 2, 4]].all() and not back[[3, 5]].any()
+    assert back[[0, 1, 4]].all() and not back[[2, 3, 5]].any()
     idx = E._layout(model)[1]
     K = E.function(model, "operator")(P[:2], starts(model, P[:2]))[2][:, idx][:, :, idx]
     for k in K:  # singular to LAPACK too: the NumPy iteration's least-squares branch answers them
@@ -177,7 +186,10 @@ def test_singular_k_is_handed_back_and_answered_as_numpy_answers():
     # the handed-back sets are the NumPy iteration's answers to the bit; the regular ones the
     # C's, which the NumPy iteration gave by least squares (a singular K was in the batch)
     assert np.array_equal(qc[back], qn[back], equal_nan=True)
-    assert_agree(qc[~back], qn[~back], rel=10 * E.TOL)
+    assert_agree(qc[[3, 5]], qn[[3, 5]], rel=10 * E.TOL)
+    alone, ok2 = numpy_iteration(model, P[2:3])
+    assert ok2[0] and okc[2]
+    assert_agree(qc[2:3], alone)
 
 
 def test_a_batch_mixing_regular_and_singular_sets():
@@ -246,3 +258,26 @@ def test_the_wrapper_checks_shapes():
         kern(P, np.zeros((3, 4)), E.TOL, 10, E.MAX_ANGLE_STEP)
     with pytest.raises(ValueError):
         kern(P[:, :-1], np.zeros((3, 5)), E.TOL, 10, E.MAX_ANGLE_STEP)
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_a_package_without_equilibrium_system_takes_the_residual_and_the_operator(name, monkeypatch):
+    """A model generated before equilibrium_system existed: the NumPy iteration builds its
+    step from the residual's rows and the operator's K (gyro.equilibrium._system), the same
+    values through another CSE: K agrees with equilibrium_system's to rounding (each entry to
+    1e-12 of its set's largest; r, a difference of far larger terms at the starts, has no
+    scale of its own to compare by), and the equilibria to 10 TOL (a coordinate at rounding
+    noise to eps of its set's largest), the same sets answered (the path without a compiler,
+late acceptance included: a set that Newton circles may stop in another step)."""
+    model = load(name)
+    P = random_sets(name, 200, seed=5)
+    idx = E._layout(model)[1]
+    q0 = starts(model, P)
+    K1 = E._system(model, idx)(P, q0)[1]
+    q1, ok1 = no_compiler(model, P)
+    monkeypatch.delitem(model.meta["functions"], "equilibrium_system")
+    K0 = E._system(model, idx)(P, q0)[1]
+    q0n, ok0 = no_compiler(model, P)
+    assert np.all(np.abs(K1 - K0) <= 1e-12 * np.max(np.abs(K0), axis=(1, 2), keepdims=True))
+    assert ok1.all() and np.array_equal(ok1, ok0)
+    assert_agree(q1, q0n, rel=10 * E.TOL)

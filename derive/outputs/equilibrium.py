@@ -15,6 +15,9 @@ def functions(d) -> list[Function]:
                     "Generalised forces dR/dq at rest on the symmetric set (R: Routh function); "
                     f"zero at a relative equilibrium. Rows: {', '.join(d.order)}."
                     + _extra(d))]
+    system = _system(d)
+    if system is not None:
+        fns.append(system)
     if model.equilibrium_approx:
         even_names = [str(x) for x in d.even]
         fns.append(Function("equilibrium_approx", [("params", model.symbols)],
@@ -23,6 +26,23 @@ def functions(d) -> list[Function]:
                             "the runtime's Newton starts (the torsion gyrocompass's (2.2), the "
                             "gyrohorizoncompass's (3.1))."))
     return fns
+
+
+def _system(d) -> Function | None:
+    """What one Newton step of the equilibria needs and nothing more: the residual's rows of
+    the equilibrium coordinates and the operator's stiffness K restricted to them, in one
+    function (one CSE: the operator's M, D and the other rows and columns of K are not
+    evaluated). None where an equilibrium coordinate is not a reduced one."""
+    names, order = [str(x) for x in d.even], list(d.order)
+    if not names or not set(names) <= set(order):
+        return None
+    idx = [order.index(c) for c in names]
+    r = sp.Matrix([d.equilibrium_residual[i] for i in idx])
+    K = d.operator.K.extract(idx, idx)
+    return Function("equilibrium_system", d.state(), [("r", r), ("K", K)],
+                    "The Newton system of the equilibria: the rows of equilibrium_residual and the "
+                    f"rows and columns of the operator's K at the equilibrium coordinates ({', '.join(names)}); "
+                    "r(qe + dq) = r(qe) - K dq to first order.", ("K",))
 
 
 def _extra(d) -> str:

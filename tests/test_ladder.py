@@ -605,19 +605,25 @@ def test_cli_stability_map_log_axis(tmp_path):
 def test_the_formulas_in_lanes_are_the_set_by_set_formulas_to_the_last_bit():
     """The compiled formulas run eight sets at a time in structure of arrays (templates/
     mode_select.c.j2); over 1,003 joint sets (a short last block) and a set outside the
-    formulas' domain (K_gamma < 0: square roots of negatives), their frequencies and
-    estimates are those of the set-by-set generated function with the selection and sort
-    done in NumPy, bit for bit (NaN where NaN)."""
+    formulas' domain (K_gamma < 0: square roots of negatives) and two sets without gravity
+    (three modes at exactly zero: ties, which the lanes' network leaves to the set-by-set
+    code, as it does a NaN), their frequencies and estimates are those of the set-by-set
+    generated function with the selection and sort done in NumPy, bit for bit (NaN where
+    NaN). (The tied zeros' estimates are all infinite, a zero being outside every formula's
+    domain: the rows written again must be their own sets', which a wrong row would show.)"""
     from bench.levels import joint
     from gyro.methods.formulas import per_mode
 
     P = joint(1003, seed=9)
     P[17, MODEL.param_names.index("Kgamma")] *= -1.0
+    P[[5, 998], MODEL.param_names.index("g")] = 0.0
     lanes = ladder.spectrum(MODEL, P, "formulas")
     f, e = per_mode(MODEL, P)  # the set-by-set C of mode_formulas
     order = np.argsort(f, axis=1, kind="stable")
     f, e = np.take_along_axis(f, order, 1), np.take_along_axis(e, order, 1)
     assert np.isnan(lanes.frequencies[17]).any()
+    for k in (5, 998):  # ties without a NaN: the set-by-set code writes these rows
+        assert np.any(np.diff(f[k]) == 0) and not np.isnan(f[k]).any()
     np.testing.assert_array_equal(lanes.frequencies, f)
     np.testing.assert_array_equal(lanes.error_estimate, e)
 

@@ -6,7 +6,7 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
-JOBS   ?= 2
+JOBS   ?= 2  # cores for make derive (models and their emission side by side) and pytest
 
 .PHONY: setup derive test test-unit check-generated pytest bench clean
 
@@ -19,7 +19,7 @@ $(STAMP): pyproject.toml constraints.txt
 	@touch $(STAMP)
 
 derive: $(STAMP)
-	$(PY) -m derive --out generated
+	$(PY) -m derive --out generated --jobs $(JOBS)
 
 # A fresh derivation under another hash seed than the committing one's gives the committed
 # bytes; `make test` tells the test suite so (tests/test_generated.py does not derive again).
@@ -27,7 +27,7 @@ HASHSEED := 4242
 
 check-generated: $(STAMP)
 	@tmp=$$(mktemp -d) && \
-	PYTHONHASHSEED=$(HASHSEED) $(PY) -m derive --out $$tmp/generated && \
+	PYTHONHASHSEED=$(HASHSEED) $(PY) -m derive --out $$tmp/generated --jobs $(JOBS) && \
 	if diff -r -x __pycache__ generated $$tmp/generated >$$tmp/diff.txt; then \
 		echo "check-generated: generated/ is up to date"; rm -rf $$tmp; \
 	else \

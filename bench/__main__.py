@@ -30,7 +30,7 @@ def bench_derive(timeout: float, skip_baseline: bool) -> dict:
     ours, _ = fresh(["-m", "bench.derive_speed"])
     print(f"  J(p): {ours['derive_J_s']:.2f} s (imports {ours['import_s']:.2f} s)", flush=True)
     print("this project: full `python -m derive` (all steps and emission) ...", flush=True)
-    _, full_wall = fresh(["-m", "derive", "--out", str(RESULTS / "_derive_tmp")])
+    _, full_wall = fresh(["-m", "derive", "--out", str(RESULTS / "_derive_tmp"), "--jobs", "2"])  # as the Makefile
     print(f"  make derive: {full_wall:.2f} s", flush=True)
     result = {"ours": ours, "ours_make_derive_s": full_wall}
     if skip_baseline:

@@ -12,7 +12,7 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
-from derive import emit, pipeline
+from derive import emit, parallel, pipeline
 from derive.model import Model, Unsupported
 from derive.models import MODELS
 
@@ -119,13 +119,50 @@ def build(module) -> Model:
     return model
 
 
+def _source_size(module) -> int:
+    try:
+        return Path(module.__file__).stat().st_size
+    except (AttributeError, TypeError, OSError):
+        return 0
+
+
+def _derive_one(module, model, out: Path, jobs: int) -> str | None:
+    """Derive and emit one model into out/<name>/, each step with its time on stderr.
+    Returns None, or the one line that says why it failed."""
+    name = model.name if model else module.__name__.rsplit(".", 1)[-1]
+    steps = pipeline.Steps(prefix=f"[{name}] ")
+    try:
+        with steps("model: energies and parameters"):
+            model = model or build(module)
+        with namespace(module):  # identities and quantities may import helpers late
+            deriv = pipeline.derive(model, steps)
+            with steps("functions to emit"):
+                fns = pipeline.functions(deriv)
+            with steps("emit: CSE, CasADi, NumPy, mpmath, C through the templates"):
+                files = emit.emit(model, fns, pipeline.metadata(deriv), out / model.name, jobs=jobs)
+    except (Unsupported, NotAModel) as exc:
+        msg = str(exc) if str(exc).startswith(f"{name}: ") else f"{name}: {exc}"
+        return msg.splitlines()[0] if msg else msg
+    except Exception as exc:  # what no check foresaw: still one line, naming the step
+        step = steps.current or "derivation"
+        return f"{name}: {step} failed: {type(exc).__name__}: {_first_line(exc)}"
+    print(f"[{name}] {len(files)} files in {out / model.name}; {steps.total:.1f} s", file=sys.stderr, flush=True)
+    return None
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m derive", description=__doc__)
     ap.add_argument("models", nargs="*", help=f"models to derive (default: all of {', '.join(MODELS)})")
     ap.add_argument("--model", metavar="PATH.py", action="append", default=[],
                     help="a model file (or folder) anywhere; may be repeated")
     ap.add_argument("--out", default="generated", help="output folder (default: generated)")
+    ap.add_argument("--jobs", type=int, default=1, metavar="N",
+                    help="cores to use: the models side by side, and each model's functions emitted "
+                         f"side by side (default 1; this machine has {parallel.usable_cores()})")
     args = ap.parse_args(argv)
+    if args.jobs < 1:
+        print(f"derive: --jobs must be at least 1, got {args.jobs}", file=sys.stderr)
+        return 2
     for name in args.models:
         if name not in MODELS:
             print(f"derive: unknown model {name!r}; known: {', '.join(MODELS)}", file=sys.stderr)
@@ -142,27 +179,25 @@ def main(argv=None) -> int:
             jobs.append((module, None))
     t_all = time.perf_counter()
     out = Path(args.out)
-    for module, model in jobs:
-        name = model.name if model else module.__name__.rsplit(".", 1)[-1]
-        steps = pipeline.Steps(prefix=f"[{name}] ")
-        try:
-            with steps("model: energies and parameters"):
-                model = model or build(module)
-            with namespace(module):  # identities and quantities may import helpers late
-                deriv = pipeline.derive(model, steps)
-                with steps("functions to emit"):
-                    fns = pipeline.functions(deriv)
-                with steps("emit: CSE, CasADi, NumPy, mpmath, C through the templates"):
-                    files = emit.emit(model, fns, pipeline.metadata(deriv), out / model.name)
-        except (Unsupported, NotAModel) as exc:
-            msg = str(exc) if str(exc).startswith(f"{name}: ") else f"{name}: {exc}"
-            print(f"derive: {msg.splitlines()[0] if msg else msg}", file=sys.stderr)
+    names = [model.name if model else module.__name__.rsplit(".", 1)[-1] for module, model in jobs]
+    if args.jobs == 1 or len(set(names)) < len(names):
+        # one at a time, stopping at the first that fails; and where two models of one name
+        # go to one folder, so that the last one named is the one left there, as asked
+        failures = []
+        for module, model in jobs:
+            failures.append(_derive_one(module, model, out, args.jobs))
+            if failures[-1]:
+                break
+    else:
+        # each model's worker shares its emission out too (the models finish at different
+        # times); the longest model file first, a rough measure of its work
+        size = [_source_size(m) for m, _ in jobs]
+        failures = parallel.pmap(lambda i: _derive_one(*jobs[i], out, args.jobs), len(jobs), args.jobs,
+                                 order=sorted(range(len(jobs)), key=lambda i: -size[i]))
+    for failure in failures:  # the first in the models' order
+        if failure:
+            print(f"derive: {failure}", file=sys.stderr)
             return 2
-        except Exception as exc:  # what no check foresaw: still one line, naming the step
-            step = steps.current or "derivation"
-            print(f"derive: {name}: {step} failed: {type(exc).__name__}: {_first_line(exc)}", file=sys.stderr)
-            return 2
-        print(f"[{name}] {len(files)} files in {out / model.name}; {steps.total:.1f} s", file=sys.stderr)
     (out / "__init__.py").write_text(emit.environment().get_template("generated_init.py.j2").render())
     print(f"derive: done in {time.perf_counter() - t_all:.1f} s", file=sys.stderr)
     return 0

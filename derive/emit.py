@@ -33,6 +33,7 @@ from sympy.printing.c import C99CodePrinter
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import MpmathPrinter, PythonCodePrinter
 
+from derive import parallel
 from derive.model import Function
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -588,8 +589,10 @@ def environment() -> jinja2.Environment:
         keep_trailing_newline=True, autoescape=False)
 
 
-def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=None) -> list[Path]:
-    """Write the generated package of one model into outdir (created, files overwritten)."""
+def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=None, jobs: int = 1) -> list[Path]:
+    """Write the generated package of one model into outdir (created, files overwritten).
+    With jobs > 1 the functions' CSE and printing are shared out among forked workers
+    (derive.parallel; the same files to the byte)."""
     import importlib
 
     import sys
@@ -603,13 +606,18 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
     env = environment()
     printers = {"c": CPrinter(), "numpy": NumpyPrinter(), "casadi": CasadiPrinter(),
                 "mpmath": MpPrinter()}
-    emitted = {k: [] for k in printers}
-    for fn in functions:
+
+    def one(i: int) -> dict:
+        fn = functions[i]
         temps, reduced, ops, ops_before = _cse(fn)
         schedule = _schedule(temps, reduced)
-        for key, printer in printers.items():
-            emitted[key].append(_printed(fn, temps, reduced, ops, ops_before, printer,
-                                         schedule if key == "c" else None))
+        return {key: _printed(fn, temps, reduced, ops, ops_before, printer, schedule if key == "c" else None)
+                for key, printer in printers.items()}
+
+    # the largest first, so that the workers finish together
+    size = [sum(len(mat) for _, mat in fn.outputs) for fn in functions]
+    done = parallel.pmap(one, len(functions), jobs, order=sorted(range(len(functions)), key=lambda i: -size[i]))
+    emitted = {k: [d[k] for d in done] for k in printers}
     source = _shown(module_file)
     common = dict(model=model.name, title=model.title, paper=model.source, source=source,
                   digest=digest, versions=tool_versions(), prefix=model.name, qep_n=_operator_dim(functions),

@@ -92,18 +92,25 @@ def test_in_one_process_each_model_builds_with_its_own_helper(two):
     assert "springs" not in sys.modules  # set aside between models, not left to the next
 
 
-def test_input_hash_tells_models_apart_and_covers_their_helpers(tmp_path):
-    """Two files of the same name and contents but for one constant, in two folders: derived
-    together, each gets the hash it gets alone, and the two differ. A helper's constant
-    changes the hash of the model beside it and of no other."""
+def chains(tmp: Path) -> list[Path]:
+    """Two files chain.py, in folders p and q, each with a springs.py beside it: the same
+    model 'chain' but for its gain, 1 and 3."""
     files = []
     for sub, gain in (("p", "1"), ("q", "3")):
-        d = tmp_path / sub
+        d = tmp / sub
         d.mkdir()
         (d / "springs.py").write_text(SERIES)
         (d / "chain.py").write_text(MODEL.format(name="chain", what="two", K="k/2").replace(
             "springs.stiffness(k)", f"{gain} * springs.stiffness(k)"))
         files.append(d / "chain.py")
+    return files
+
+
+def test_input_hash_tells_models_apart_and_covers_their_helpers(tmp_path):
+    """Two files of the same name and contents but for one constant, in two folders: derived
+    together, each gets the hash it gets alone, and the two differ. A helper's constant
+    changes the hash of the model beside it and of no other."""
+    files = chains(tmp_path)
     from derive import emit
 
     together = [emit.input_hash(f) for f in files]

@@ -1,0 +1,98 @@
+"""`python -m derive --jobs N` (derive.parallel): the models side by side and each model's
+functions emitted side by side give the files of one job to the byte, the results in the
+tasks' order whatever order they ran in; a failure in a worker is one line and exit 2; two
+models of one name are still derived one after the other, the last named left."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from derive import parallel
+from tests.conftest import ROOT
+
+
+def _pid(i: int) -> tuple[int, int]:
+    return i, os.getpid()
+
+
+def test_pmap_gives_the_results_in_index_order_from_other_processes():
+    order = [5, 3, 1, 0, 2, 4]
+    out = parallel.pmap(_pid, 6, 2, order=order)
+    assert [i for i, _ in out] == list(range(6))
+    if parallel.can_fork():
+        assert all(pid != os.getpid() for _, pid in out)
+    assert parallel.pmap(_pid, 6, 1, order=order) == [(i, os.getpid()) for i in range(6)]  # one job: here, in order
+
+
+def test_pmap_raises_a_tasks_exception_and_refuses_a_bad_order():
+    def task(i):
+        if i == 3:
+            raise ArithmeticError(f"task {i}")
+        return i
+
+    for jobs in (1, 2):
+        with pytest.raises(ArithmeticError, match="task 3"):
+            parallel.pmap(task, 5, jobs)
+    with pytest.raises(ValueError, match="order"):
+        parallel.pmap(task, 3, 2, order=[0, 1, 1])
+    assert parallel._TASK == []  # nothing left behind for a later pmap
+
+
+def _derive(out, *args, jobs=1):
+    return subprocess.run([sys.executable, "-m", "derive", *args, "--out", str(out), "--jobs", str(jobs)],
+                          cwd=ROOT, capture_output=True, text=True)
+
+
+def _files(folder):
+    return {p.relative_to(folder): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()
+            and "__pycache__" not in p.parts}
+
+
+def test_two_jobs_write_the_bytes_of_one_job(tmp_path):
+    """Two seed models side by side, each one's functions emitted by two workers: every file
+    the same to the byte as one model and one function after another."""
+    one, two = _derive(tmp_path / "one", "gimbal_gyroscope", "gimbal_precession"), \
+        _derive(tmp_path / "two", "gimbal_gyroscope", "gimbal_precession", jobs=2)
+    assert one.returncode == 0 and two.returncode == 0, one.stderr + two.stderr
+    a, b = _files(tmp_path / "one"), _files(tmp_path / "two")
+    assert len(a) == 15 and a.keys() == b.keys()
+    assert [k for k in a if a[k] != b[k]] == []
+    assert "[gimbal_precession] emit: CSE" in two.stderr and "derive: done in" in two.stderr
+
+
+def test_a_failure_in_a_worker_is_one_line_and_exit_2(tmp_path):
+    """A model that builds but whose derivation is refused (a force on a cyclic coordinate),
+    beside one that derives: exit 2, the refusal in one line naming the model, no traceback."""
+    from tests.test_machinery import MODEL_FILE, _write_model
+
+    (tmp_path / "good").mkdir()
+    bad = _write_model(tmp_path / "wheel_cart.py", MODEL_FILE.format(name="wheel_cart", momentum="0"))
+    good = _write_model(tmp_path / "good" / "wheel_free.py",
+                        MODEL_FILE.format(name="wheel_free", momentum="0").replace(
+                            ', generalized_forces={"th": tau.symbol}', ""))
+    proc = _derive(tmp_path / "out", "--model", str(good), "--model", str(bad), jobs=2)
+    assert proc.returncode == 2
+    last = proc.stderr.strip().splitlines()[-1]
+    assert last.startswith("derive: wheel_cart") and "force acts on the cyclic coordinate th" in last
+    assert "Traceback" not in proc.stderr
+    proc = _derive(tmp_path / "out", "--model", str(good), jobs=0)
+    assert proc.returncode == 2 and proc.stderr.strip() == "derive: --jobs must be at least 1, got 0"
+
+
+def test_two_models_of_one_name_leave_the_last_named_with_two_jobs(tmp_path):
+    """Two files that both build a model 'chain' (one folder): with --jobs 2 they are not
+    written side by side into it; the one named last is what the folder holds, as with one
+    job."""
+    from derive import emit
+    from tests.test_model_namespace import chains
+
+    files = chains(tmp_path)
+    for order in (files, files[::-1]):
+        proc = _derive(tmp_path / "both", *[a for f in order for a in ("--model", str(f))], jobs=2)
+        assert proc.returncode == 0, proc.stderr
+        meta = json.loads((tmp_path / "both" / "chain" / "metadata.json").read_text())
+        assert meta["generated"]["input_hash"] == emit.input_hash(order[-1])

@@ -5,7 +5,8 @@ every generated model, casadi.CodeGenerator writes C for the same casadi.Functio
 in generated/<model>/casadi_functions.py). Both are compiled by the same compiler with the
 same flags (gyro.cbackend.FLAGS without -shared and -fPIC) into one harness that calls each
 through a function pointer N times on the model's defaults (a pointer call across
-translation units: nothing inlined or hoisted), alternating ours and CasADi's, R times. The
+translation units: nothing inlined or hoisted), alternating ours and CasADi's, R times,
+ours first in even runs and CasADi's first in odd ones. The
 figures are medians in ns per evaluation and the ratio ours / CasADi's (< 1: ours faster),
 measured in the same process on a shared machine, with the quartiles of the ratio run by
 run (their spread: quartiles on both sides of 1 are no measured difference). Both write only
@@ -111,9 +112,16 @@ def one_model(name: str, evals: int, repeats: int, tmp: Path) -> list[dict]:
         lines.append(f"    int (*volatile theirs)(const double **, double **, casadi_int *, double *, int) = {fname};")
         lines.append("    for (long r = 0; r < repeats; ++r) {")
         zero = " ".join(f"memset(out{j}, 0, sizeof out{j});" for j in range(len(outs)))
-        lines.append(f"      double t0 = now(); {zero} for (long e = 0; e < evals; ++e) {{ ours({ours_args}); sink += out0[0]; }}")
-        lines.append("      double t1 = now(); for (long e = 0; e < evals; ++e) { theirs(arg, res, iw, w, 0); sink += out0[0]; }")
-        lines.append(f"      double t2 = now(); printf(\"%d %.6e %.6e\\n\", (t1 - t0) / evals, (t2 - t1) / evals);", )
+        # the order alternates run by run (ours first, then CasADi's first): whatever the
+        # first of a pair pays or gains (a warmer cache, a clock ramping up) falls on both
+        lines.append("      double ta, tb;")
+        lines.append(f"      if (r % 2 == 0) {{ double t0 = now(); {zero} for (long e = 0; e < evals; ++e) {{ ours({ours_args}); sink += out0[0]; }}")
+        lines.append("        double t1 = now(); for (long e = 0; e < evals; ++e) { theirs(arg, res, iw, w, 0); sink += out0[0]; }")
+        lines.append("        double t2 = now(); ta = t1 - t0; tb = t2 - t1; }")
+        lines.append("      else { double t0 = now(); for (long e = 0; e < evals; ++e) { theirs(arg, res, iw, w, 0); sink += out0[0]; }")
+        lines.append(f"        double t1 = now(); {zero} for (long e = 0; e < evals; ++e) {{ ours({ours_args}); sink += out0[0]; }}")
+        lines.append("        double t2 = now(); tb = t1 - t0; ta = t2 - t1; }")
+        lines.append(f"      printf(\"%d %.6e %.6e\\n\", ta / evals, tb / evals);", )
         lines.append("    }")
         lines.append("  }")
         body.append("\n".join(lines).replace("%d", str(i)))

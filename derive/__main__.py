@@ -192,8 +192,12 @@ def main(argv=None) -> int:
         # each model's worker shares its emission out too (the models finish at different
         # times); the longest model file first, a rough measure of its work
         size = [_source_size(m) for m, _ in jobs]
-        failures = parallel.pmap(lambda i: _derive_one(*jobs[i], out, args.jobs), len(jobs), args.jobs,
-                                 order=sorted(range(len(jobs)), key=lambda i: -size[i]))
+        try:
+            failures = parallel.pmap(lambda i: _derive_one(*jobs[i], out, args.jobs), len(jobs), args.jobs,
+                                     order=sorted(range(len(jobs)), key=lambda i: -size[i]))
+        except parallel.WorkerDied as exc:  # killed (out of memory, a signal): no result to report
+            print(f"derive: {exc}", file=sys.stderr)
+            return 2
     for failure in failures:  # the first in the models' order
         if failure:
             print(f"derive: {failure}", file=sys.stderr)

@@ -21,6 +21,10 @@ from typing import Callable
 _TASK: list[Callable[[int], object]] = []  # the task of the innermost pmap, for the forked workers
 
 
+class WorkerDied(RuntimeError):
+    """A worker ended without a result (killed by a signal, out of memory); one line."""
+
+
 def usable_cores() -> int:
     """The cores this process may run on (its affinity where the platform tells it)."""
     try:
@@ -51,6 +55,8 @@ def pmap(task: Callable[[int], object], n: int, jobs: int, order: list[int] | No
     try:
         with cf.ProcessPoolExecutor(min(jobs, n), mp_context=mp.get_context("fork")) as ex:
             done = dict(zip(order, ex.map(_run, order)))
+    except cf.process.BrokenProcessPool as exc:
+        raise WorkerDied(f"a worker process ended without its result ({exc}); try --jobs 1") from None
     finally:
         _TASK.pop()
     return [done[i] for i in range(n)]

@@ -96,3 +96,20 @@ def test_two_models_of_one_name_leave_the_last_named_with_two_jobs(tmp_path):
         assert proc.returncode == 0, proc.stderr
         meta = json.loads((tmp_path / "both" / "chain" / "metadata.json").read_text())
         assert meta["generated"]["input_hash"] == emit.input_hash(order[-1])
+
+
+def test_a_worker_killed_is_reported_not_waited_for():
+    """A worker that dies without a result (here: it kills itself) raises WorkerDied in one
+    line; it neither hangs nor hands back a partial list."""
+    import signal
+
+    def task(i):
+        if i == 1:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return i
+
+    if not parallel.can_fork():
+        pytest.skip("no fork on this platform: the tasks run in this process")
+    with pytest.raises(parallel.WorkerDied, match="without its result"):
+        parallel.pmap(task, 3, 2)
+    assert parallel._TASK == []

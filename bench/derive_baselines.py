@@ -27,7 +27,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import platform
 import shutil
 import subprocess
 import sys
@@ -37,6 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bench import machine
 from bench.baselines.common import fresh
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -332,8 +332,7 @@ def main(argv=None) -> int:
         row["bench_command"] = command
     rows = {**old.get("models", {}), **new}
     res = {"models": rows, "goal_ratio": GOAL_RATIO, "command": command,
-           "machine": {"python": platform.python_version(), "processor": platform.machine(),
-                       "cores": __import__("os").cpu_count()}}
+           "machine": machine()}
     if not args.no_make_derive:
         res["make_derive"] = bench_make_derive()
     elif "make_derive" in old:

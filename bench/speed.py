@@ -35,6 +35,7 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from bench import machine  # noqa: E402
 from gyro import cbackend, ladder, load, qep  # noqa: E402
 from gyro.equilibrium import equilibria, operators  # noqa: E402
 
@@ -122,7 +123,7 @@ def measure(sets: int = 20000, repeats: int = 5) -> dict:
     steps = _steps(M, D, K, w0, z0)
     eig = med["eigvals of the companion (LAPACK)"]
     return {
-        "sets": sets, "repeats": repeats, "seed": 20261201, "threads": 1,
+        "sets": sets, "repeats": repeats, "seed": 20261201, "threads": 1, "machine": machine(),
         "note": "medians of the repetitions, all pieces alternating in one process on a shared machine",
         "s_per_set": med, "all_s_per_set": times,
         "sets_per_s": {k: 1 / v for k, v in med.items()},

@@ -33,10 +33,28 @@ TIERS = {
 _TIER_OF = {f: tier for tier, files in TIERS.items() for f in files}
 
 
+def _tested_tree_is_this_one() -> None:
+    """The gyro package and its generated code that the tests import are this checkout's:
+    an environment installed (editable) from another checkout, a git worktree's say, maps
+    gyro.generated to that checkout's generated/, and the tests would pass or fail on code
+    that is not the one in front of them."""
+    import gyro
+    import gyro.generated
+
+    where = {"gyro": Path(gyro.__file__).resolve().parent, "gyro.generated": Path(list(gyro.generated.__path__)[0]).resolve()}
+    want = {"gyro": (ROOT / "gyro").resolve(), "gyro.generated": GENERATED.resolve()}
+    wrong = [f"{k} from {where[k]}" for k in where if where[k] != want[k]]
+    if wrong:
+        raise pytest.UsageError(f"the tests of {ROOT} import {', '.join(wrong)}: install this checkout "
+                                f"(make setup in it, or pip install -e {ROOT}) before testing it")
+
+
 def pytest_sessionstart(session):
-    """Every generated model's C compiled once before the tests (in the controlling process
-    only): the command-line tests hold stderr to one line, and the first use of a library
-    after its C changed says on stderr that it compiles it."""
+    """The code under test is this checkout's; every generated model's C compiled once
+    before the tests (in the controlling process only): the command-line tests hold stderr
+    to one line, and the first use of a library after its C changed says on stderr that it
+    compiles it."""
+    _tested_tree_is_this_one()
     if hasattr(session.config, "workerinput"):
         return
     from gyro import cbackend

@@ -32,6 +32,7 @@ RESULTS = ROOT / "bench" / "results"
 MODEL = load("torsion_gyrocompass")
 GOALS = {"default_sets_per_s": 1e5, "default_rel_error": 1e-10, "formulas_sets_per_s": 2e7,
          "reference_s_per_set": 1.0}
+FLOORS = ("one 10x10 complex LU solve per root", "memory traffic of the batch")
 BATCH = {"formulas": 1_000_000, "polyroots": 300, "companion": 20000, "default": 20000}
 # the compiled rungs again on their NumPy paths (a machine without gcc): same algorithm
 NUMPY_PATH = {"default, NumPy path": "default", "formulas, NumPy path": "formulas"}
@@ -96,8 +97,7 @@ def floor_times(P: np.ndarray, sets: int = 20000, repeats: int = 3) -> dict[str,
         fl["copy_32MB"]()
         copy.append(time.perf_counter() - t0)
     bandwidth = fl["_copy_bytes"] / float(np.median(copy))
-    return {"one 10x10 complex LU solve per root": float(np.median(lu)),
-            "memory traffic of the batch": fl["_bytes_per_set"] / bandwidth}
+    return dict(zip(FLOORS, (float(np.median(lu)), fl["_bytes_per_set"] / bandwidth)))
 
 
 def main() -> int:
@@ -182,7 +182,12 @@ def chart(out: dict) -> None:
              "formulas, NumPy path": ("tab:blue", "s")}
     fig, axes = plt.subplots(2, 2, figsize=(11, 8.5), sharex=True, sharey=True, layout="constrained")
     floor = 1e-17  # an error of exactly zero is drawn here
-    for ax, (name, entry) in zip(axes.ravel(), out["spreads"].items()):
+    # the panels and the floors in the bench's own order, also when drawn again from
+    # ladder.json (written with sorted keys)
+    names = [k for k in spreads() if k in out["spreads"]] + [k for k in out["spreads"] if k not in spreads()]
+    floors_ = {k: out["floors_s_per_set"][k] for k in FLOORS if k in out["floors_s_per_set"]}
+    for ax, name in zip(axes.ravel(), names):
+        entry = out["spreads"][name]
         for m, (color, marker) in style.items():
             t = out["seconds_per_set"][m]
             raw = np.nan_to_num(np.asarray(entry["methods"][m]["max_rel_error_per_frequency"], float), nan=np.inf)
@@ -203,13 +208,15 @@ def chart(out: dict) -> None:
                         (f"up to {r_:.0e}" if np.isfinite(r_) else "roots lost"))
                 ax.annotate(text, (jitter[sel][-1], errs[sel][-1]), fontsize=6, color=color,
                             xytext=(4, 4 if side == "low" else -9), textcoords="offset points")
+            # left of its point where omega1 is drawn at an edge: its value's label is on the right
             ax.annotate("omega1", (jitter[0], errs[0]), fontsize=6, color=color,
-                        xytext=(3, 3), textcoords="offset points")
+                        xytext=(-4, 4) if clipped[0] else (3, 3), textcoords="offset points",
+                        ha="right" if clipped[0] else "left")
         ax.axhline(1e-10, color="k", lw=0.7, ls="--")
         ax.axvline(1 / GOALS["default_sets_per_s"], color="tab:green", lw=0.7, ls=":")
         ax.axvline(1 / GOALS["formulas_sets_per_s"], color="tab:blue", lw=0.7, ls=":")
         ax.axvline(GOALS["reference_s_per_set"], color="tab:purple", lw=0.7, ls=":")
-        for (k, t), ls in zip(out["floors_s_per_set"].items(), ("-.", (0, (1, 3)))):
+        for (k, t), ls in zip(floors_.items(), ("-.", (0, (1, 3)))):
             ax.axvline(t, color="0.35", lw=0.9, ls=ls, label=f"floor: {k}" if ax is axes[0, 0] else None)
         ax.set_xscale("log")
         ax.set_yscale("log")

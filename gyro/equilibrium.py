@@ -132,8 +132,9 @@ def _newton(model: Model, P, qe, idx, is_angle, tol, max_iter):
 
 def _newton_numpy(model: Model, P, qe, idx, is_angle, tol, max_iter):
     """The Newton iteration vectorised over the batch, qe (the starts) iterated in place:
-    a set whose r or K is not below 1e150 takes a NaN step (it fails), and where any K of the
-    batch is singular every set of that step takes least squares; converged when every
+    a set whose r or K is not below 1e150 takes a NaN step (it fails), and a set whose K is
+    singular takes least squares (its step, and so its answer, is the one it gets alone,
+    whatever batch it is in); converged when every
     |dq_i| <= tol max(largest |qe_j| of i's group (_groups), 1e-300) + 1e-300. Returns
     (qe, converged)."""
     n = P.shape[0]
@@ -153,9 +154,8 @@ def _newton_numpy(model: Model, P, qe, idx, is_angle, tol, max_iter):
             # r(q + dq) = r(q) - K dq  (r = dR/dq, K = -d2R/dq2)
             try:
                 dq = np.linalg.solve(K, r[..., None])[..., 0]
-            except np.linalg.LinAlgError:  # a singular K somewhere: least squares set by set
-                dq = np.array([np.linalg.lstsq(k, v, rcond=None)[0] if t else v
-                               for k, v, t in zip(K, r, ok_in)])
+            except np.linalg.LinAlgError:  # a singular K somewhere: set by set, least squares where singular
+                dq = np.array([_solve_or_lstsq(k, v) if t else v for k, v, t in zip(K, r, ok_in)])
         big = np.max(np.abs(np.where(is_angle, dq, 0.0)), axis=1, initial=0.0)
         dq *= np.minimum(1.0, MAX_ANGLE_STEP / np.maximum(big, 1e-300))[:, None]
         qe[a] += dq
@@ -166,6 +166,15 @@ def _newton_numpy(model: Model, P, qe, idx, is_angle, tol, max_iter):
         active[a[conv | bad]] = False
         qe[a[bad]] = np.nan
     return qe, converged
+
+
+def _solve_or_lstsq(K, r):
+    """K^-1 r, as the batched solve gives it (LAPACK's gesv on this K alone), or least squares
+    where K is singular: a set's step is the same whatever batch it is in."""
+    try:
+        return np.linalg.solve(K, r)
+    except np.linalg.LinAlgError:
+        return np.linalg.lstsq(K, r, rcond=None)[0]
 
 
 def _system(model: Model, idx):

@@ -155,6 +155,19 @@ def test_one_step_of_the_c_is_one_step_of_numpy(name):
     assert np.all(np.abs(step_c - step_n) <= bound[:, None])
 
 
+def singular_batch(model):
+    """Six sets of the torsion gyrocompass: no Earth rate with g = 0; no Earth rate and no
+    torsion stiffness; g = 0; latitude 90 deg; g = 0 at latitude 90 deg; the defaults."""
+    ix = model.param_names.index
+    P = np.tile(model.vector(model.defaults), (6, 1))
+    P[0, [ix("g"), ix("u")]] = 0.0
+    P[1, [ix("u"), ix("Kgamma")]] = 0.0
+    P[2, ix("g")] = 0.0
+    P[3, ix("phi")] = 90.0
+    P[4, [ix("g"), ix("phi")]] = [0.0, 90.0]
+    return P
+
+
 def test_singular_k_is_handed_back_and_answered_as_numpy_answers():
     """No Earth rate with g = 0 (or with no torsion stiffness): K is singular at the start,
     the NumPy iteration takes least squares. g = 0 leaves K singular in exact arithmetic
@@ -164,13 +177,7 @@ def test_singular_k_is_handed_back_and_answered_as_numpy_answers():
     answers it, as the NumPy iteration of that set does, alone or in this batch. Latitude
     90 deg alone: K regular, the C answers."""
     model = load("torsion_gyrocompass")
-    ix = model.param_names.index
-    P = np.tile(model.vector(model.defaults), (6, 1))
-    P[0, [ix("g"), ix("u")]] = 0.0
-    P[1, [ix("u"), ix("Kgamma")]] = 0.0
-    P[2, ix("g")] = 0.0
-    P[3, ix("phi")] = 90.0
-    P[4, [ix("g"), ix("phi")]] = [0.0, 90.0]
+    P = singular_batch(model)
     _, status = kernel_run(model, P)
     back = status == cbackend.EquilibriumNewton.HANDED_BACK
     assert back[[0, 1, 4]].all() and not back[[2, 3, 5]].any()
@@ -197,13 +204,7 @@ def test_numpy_iteration_answers_each_set_as_alone_whatever_its_batch():
     before, every set of the step took least squares, and g = 0 came to another point of
     its free azimuth in the batch than alone)."""
     model = load("torsion_gyrocompass")
-    ix = model.param_names.index
-    P = np.tile(model.vector(model.defaults), (6, 1))
-    P[0, [ix("g"), ix("u")]] = 0.0
-    P[1, [ix("u"), ix("Kgamma")]] = 0.0
-    P[2, ix("g")] = 0.0
-    P[3, ix("phi")] = 90.0
-    P[4, [ix("g"), ix("phi")]] = [0.0, 90.0]
+    P = singular_batch(model)
     q, ok = numpy_iteration(model, P)
     for k in range(len(P)):
         qk, okk = numpy_iteration(model, P[k:k + 1])

@@ -6,7 +6,8 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
-JOBS   ?= 2  # cores for make derive (models and their emission side by side) and pytest
+# cores for make derive (models and their emission side by side) and for pytest
+JOBS   ?= 2
 
 .PHONY: setup derive test test-unit check-generated pytest bench clean
 

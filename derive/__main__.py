@@ -3,18 +3,23 @@
 to DIR/<name>/, step by step with the time of each step."""
 from __future__ import annotations
 
-import argparse
-import hashlib
-import importlib
-import importlib.util
-import sys
-import time
-from contextlib import contextmanager
-from pathlib import Path
+import os
 
-from derive import emit, parallel, pipeline
-from derive.model import Model, Unsupported
-from derive.models import MODELS
+# no BLAS threads: the derivation has no use for them, and --jobs forks this process
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import argparse  # noqa: E402
+import hashlib  # noqa: E402
+import importlib  # noqa: E402
+import importlib.util  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from contextlib import contextmanager  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+from derive import emit, parallel, pipeline  # noqa: E402
+from derive.model import Model, Unsupported  # noqa: E402
+from derive.models import MODELS  # noqa: E402
 
 
 class NotAModel(ValueError):
@@ -157,8 +162,9 @@ def main(argv=None) -> int:
                     help="a model file (or folder) anywhere; may be repeated")
     ap.add_argument("--out", default="generated", help="output folder (default: generated)")
     ap.add_argument("--jobs", type=int, default=1, metavar="N",
-                    help="cores to use: the models side by side, and each model's functions emitted "
-                         f"side by side (default 1; this machine has {parallel.usable_cores()})")
+                    help="cores to use (Linux): up to N models side by side, each sharing the emission "
+                         "of its functions among up to N workers of its own (default 1; this machine "
+                         f"has {parallel.usable_cores()})")
     args = ap.parse_args(argv)
     if args.jobs < 1:
         print(f"derive: --jobs must be at least 1, got {args.jobs}", file=sys.stderr)

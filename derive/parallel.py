@@ -4,25 +4,37 @@
 emission of its functions (CSE and four printers each, independent of one another) is
 shared out. The workers are forked (concurrent.futures over the "fork" start method), so a
 task sees everything its parent had built, the symbolic results included, without pickling
-them; only its return value travels back (for the emitter, printed text). Where the
-platform cannot fork, or one job is asked for, the tasks run in this process in order.
-Either way the results are those of running the tasks one after another: each task is a
-pure function of what was built before the workers were forked, and the results come back
-in the tasks' order (tests/test_parallel_derive.py holds the emitted files to the bytes of
-a run with one job).
+them; only its return value travels back (for the emitter, printed text). Either way the
+results are those of running the tasks one after another: each task is a pure function of
+what was built before the workers were forked, the results come back in the tasks' order,
+and where tasks fail the one raised is the first by index, as a loop would raise it
+(tests/test_parallel_derive.py holds the emitted files to the bytes of a run with one job).
+
+Workers run on Linux only, where each is tied to its parent's life (PR_SET_PDEATHSIG): a
+worker whose parent dies (killed, out of memory, a signal) is killed with it, so that no
+worker outlives the command or writes after it, and a worker's death closes the pipes its
+parent waits on, which is how the parent learns of it (a pool inside a worker is a
+grandchild of the command). Elsewhere, or with one job, the tasks run in this process.
 """
 from __future__ import annotations
 
 import concurrent.futures as cf
+import ctypes
 import multiprocessing as mp
 import os
+import pickle
+import signal
+import sys
+from functools import lru_cache
 from typing import Callable
 
 _TASK: list[Callable[[int], object]] = []  # the task of the innermost pmap, for the forked workers
+_PR_SET_PDEATHSIG = 1
 
 
 class WorkerDied(RuntimeError):
-    """A worker ended without a result (killed by a signal, out of memory); one line."""
+    """A worker ended without a result (killed by a signal, out of memory), or none could be
+    started; one line."""
 
 
 def usable_cores() -> int:
@@ -33,30 +45,76 @@ def usable_cores() -> int:
         return os.cpu_count() or 1
 
 
+@lru_cache(maxsize=None)
+def _prctl():
+    try:
+        fn = ctypes.CDLL(None, use_errno=True).prctl
+    except (OSError, AttributeError):
+        return None
+    fn.argtypes, fn.restype = (ctypes.c_int, ctypes.c_ulong), ctypes.c_int
+    return fn
+
+
 def can_fork() -> bool:
-    return "fork" in mp.get_all_start_methods()
+    """Workers are used where they can be forked and tied to their parent's life: Linux."""
+    return sys.platform.startswith("linux") and "fork" in mp.get_all_start_methods() and _prctl() is not None
+
+
+def _tie_to_parent(parent: int) -> None:
+    """A worker's initializer: killed when its parent dies (and at once if it already has)."""
+    _prctl()(_PR_SET_PDEATHSIG, signal.SIGKILL)
+    if os.getppid() != parent:
+        os._exit(1)
 
 
 def _run(i: int):
-    return _TASK[-1](i)
+    try:
+        return _TASK[-1](i)
+    except Exception as exc:  # one that cannot travel back would reach the parent as a dead pool
+        try:
+            pickle.loads(pickle.dumps(exc))
+        except Exception:
+            raise RuntimeError(f"{type(exc).__name__}: {exc}") from None
+        raise
 
 
 def pmap(task: Callable[[int], object], n: int, jobs: int, order: list[int] | None = None) -> list:
     """[task(0), ..., task(n - 1)], on up to `jobs` forked workers. `order` is the order in
     which the tasks are handed out (the longest first balances the workers best); the
-    results are returned in index order whatever it is. An exception in a task is raised
-    here, as it would be in a plain loop."""
+    results are returned in index order whatever it is. Where tasks raise, the exception of
+    the first by index is raised here, after the others have ended, as a loop would raise
+    it; a worker that dies without a result (a signal, out of memory), or workers that
+    cannot be started, raise WorkerDied."""
     order = list(range(n)) if order is None else list(order)
     if sorted(order) != list(range(n)):
         raise ValueError("order: not a permutation of the tasks")
     if jobs <= 1 or n <= 1 or not can_fork():
         return [task(i) for i in range(n)]
     _TASK.append(task)
+    ex = cf.ProcessPoolExecutor(min(jobs, n), mp_context=mp.get_context("fork"),
+                                initializer=_tie_to_parent, initargs=(os.getpid(),))
+    done = False
     try:
-        with cf.ProcessPoolExecutor(min(jobs, n), mp_context=mp.get_context("fork")) as ex:
-            done = dict(zip(order, ex.map(_run, order)))
-    except cf.process.BrokenProcessPool as exc:
-        raise WorkerDied(f"a worker process ended without its result ({exc}); try --jobs 1") from None
+        try:
+            futures = dict(zip(order, (ex.submit(_run, i) for i in order)))
+        except OSError as exc:  # no process or pipe to be had (a limit, memory)
+            raise WorkerDied(f"the worker processes could not be started ({exc}); try --jobs 1") from None
+        cf.wait(futures.values())
+        for i in range(n):
+            exc = futures[i].exception()
+            if isinstance(exc, cf.process.BrokenProcessPool):
+                raise WorkerDied(f"a worker process ended without its result ({exc}); try --jobs 1") from None
+            if exc is not None:
+                raise exc
+        done = True
+        return [futures[i].result() for i in range(n)]
     finally:
         _TASK.pop()
-    return [done[i] for i in range(n)]
+        if done:
+            ex.shutdown(wait=True)
+        else:  # no worker left behind: one waiting on a pool that broke or never filled
+            left = list((getattr(ex, "_processes", None) or {}).values())
+            ex.shutdown(wait=False, cancel_futures=True)
+            for p in left:
+                if p.is_alive():
+                    p.kill()

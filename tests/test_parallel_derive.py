@@ -42,6 +42,93 @@ def test_pmap_raises_a_tasks_exception_and_refuses_a_bad_order():
     assert parallel._TASK == []  # nothing left behind for a later pmap
 
 
+def test_pmap_raises_the_first_failure_by_index_and_one_that_cannot_travel():
+    """Two tasks fail, handed out last first: the one raised is the first by index, as a
+    loop raises it. An exception that cannot be rebuilt in the parent arrives as its type
+    and message, not as a dead worker."""
+    class Odd(Exception):
+        def __init__(self, a, b):  # pickles, but cannot be rebuilt from its args
+            super().__init__(f"odd {a} {b}")
+
+    def task(i):
+        if i in (1, 3):
+            raise LookupError(f"task {i}")
+        if i == 4:
+            raise Odd(1, 2)
+        return i
+
+    for jobs in (1, 2):
+        with pytest.raises(LookupError, match="task 1"):
+            parallel.pmap(task, 4, jobs, order=[3, 2, 1, 0])
+        with pytest.raises(Exception, match="odd 1 2"):
+            parallel.pmap(lambda i: task(4) if i == 1 else i, 2, jobs)
+
+
+NESTED = """
+import os, signal, sys, time
+sys.path.insert(0, {root!r})
+from derive import parallel
+
+def inner(i):
+    if i == 1:
+        os.kill(os.getppid(), signal.SIGKILL)  # the outer worker, parent of this one, dies
+    time.sleep(0.5)
+    return i
+
+def outer(i):
+    return parallel.pmap(inner, 2, 2) if i == 0 else (time.sleep(1), i)[1]
+
+try:
+    parallel.pmap(outer, 2, 2)
+except parallel.WorkerDied as exc:
+    print("died:", exc)
+"""
+
+
+def test_a_worker_killed_while_its_own_workers_run_is_reported_and_none_is_left(tmp_path):
+    """A worker that dies while its own pool (a model's emission) runs: the command learns of
+    it (its children die with it, and with them the pipes it waits on), reports it in one
+    line and ends; no worker of either level is left running."""
+    if not parallel.can_fork():
+        pytest.skip("workers only where they can be tied to their parent (Linux)")
+    script = tmp_path / "nested.py"
+    script.write_text(NESTED.format(root=str(ROOT)))
+    proc = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=60)
+    assert proc.stdout.startswith("died: a worker process ended without its result"), proc.stdout + proc.stderr
+    left = subprocess.run(["pgrep", "-f", str(script)], capture_output=True, text=True).stdout.split()
+    assert left == []
+
+
+def test_two_jobs_derive_and_emit_in_other_processes(tmp_path, monkeypatch):
+    """--jobs 2 does what it says: every function of both models is emitted in a process
+    other than the command's, at least two of them; with one job, all in the command's."""
+    import contextlib
+    import io
+
+    from derive import emit
+    from derive.__main__ import main
+
+    log = tmp_path / "pids.txt"
+    real = emit._cse
+
+    def recording(fn):
+        with open(log, "a") as f:
+            f.write(f"{os.getpid()} {fn.name}\n")
+        return real(fn)
+
+    monkeypatch.setattr(emit, "_cse", recording)
+    for jobs in ("2", "1"):
+        log.write_text("")
+        with contextlib.redirect_stderr(io.StringIO()):
+            assert main(["gimbal_gyroscope", "gimbal_precession", "--out", str(tmp_path / jobs), "--jobs", jobs]) == 0
+        pids = {int(line.split()[0]) for line in log.read_text().splitlines()}
+        assert len(log.read_text().splitlines()) > 20
+        if jobs == "1" or not parallel.can_fork():
+            assert pids == {os.getpid()}
+        else:
+            assert os.getpid() not in pids and len(pids) >= 2
+
+
 def _derive(out, *args, jobs=1):
     return subprocess.run([sys.executable, "-m", "derive", *args, "--out", str(out), "--jobs", str(jobs)],
                           cwd=ROOT, capture_output=True, text=True)
@@ -81,6 +168,26 @@ def test_a_failure_in_a_worker_is_one_line_and_exit_2(tmp_path):
     assert "Traceback" not in proc.stderr
     proc = _derive(tmp_path / "out", "--model", str(good), jobs=0)
     assert proc.returncode == 2 and proc.stderr.strip() == "derive: --jobs must be at least 1, got 0"
+
+
+def test_a_model_worker_killed_is_one_line_and_exit_2(tmp_path):
+    """A model whose derivation kills its own process (an identity that sends itself
+    SIGKILL), beside one that derives, with --jobs 2: one line naming what happened, exit 2,
+    no traceback, within a bound."""
+    from tests.test_model_namespace import PARALLEL, SERIES, _folder
+
+    good = _folder(tmp_path, "a", "series", SERIES, "two in series")
+    bad = _folder(tmp_path, "b", "parallel", PARALLEL, "two in parallel")
+    bad.write_text("import os, signal\n\ndef _dies():\n    os.kill(os.getpid(), signal.SIGKILL)\n"
+                   + bad.read_text().replace('symmetric_zero=["x"])', 'symmetric_zero=["x"], identities={"dies": _dies})'))
+    proc = subprocess.run([sys.executable, "-m", "derive", "--model", str(good), "--model", str(bad),
+                           "--out", str(tmp_path / "out"), "--jobs", "2"],
+                          cwd=ROOT, capture_output=True, text=True, timeout=120)
+    if not parallel.can_fork():
+        pytest.skip("workers only where they can be tied to their parent (Linux)")
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    last = proc.stderr.strip().splitlines()[-1]
+    assert last.startswith("derive: a worker process ended without its result"), proc.stderr
 
 
 def test_two_models_of_one_name_leave_the_last_named_with_two_jobs(tmp_path):

@@ -26,6 +26,7 @@ import pickle
 import signal
 import sys
 from functools import lru_cache
+from multiprocessing.reduction import ForkingPickler
 from typing import Callable
 
 _TASK: list[Callable[[int], object]] = []  # the task of the innermost pmap, for the forked workers
@@ -70,12 +71,17 @@ def _tie_to_parent(parent: int) -> None:
 def _run(i: int):
     try:
         return _TASK[-1](i)
-    except Exception as exc:  # one that cannot travel back would reach the parent as a dead pool
+    except Exception as exc:
+        # one that cannot travel back would reach the parent as a dead pool: pickled as the
+        # result queue pickles it (with the reducers other packages register: tblib's,
+        # installed by dask.distributed, pickles an exception's context and cause too)
         try:
-            pickle.loads(pickle.dumps(exc))
+            pickle.loads(ForkingPickler.dumps(exc))
         except Exception:
-            raise RuntimeError(f"{type(exc).__name__}: {exc}") from None
-        raise
+            message = f"{type(exc).__name__}: {exc}"
+        else:
+            raise
+    raise RuntimeError(message)  # raised outside the handler: no context to carry along
 
 
 def pmap(task: Callable[[int], object], n: int, jobs: int, order: list[int] | None = None) -> list:

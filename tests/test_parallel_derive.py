@@ -45,7 +45,11 @@ def test_pmap_raises_a_tasks_exception_and_refuses_a_bad_order():
 def test_pmap_raises_the_first_failure_by_index_and_one_that_cannot_travel():
     """Two tasks fail, handed out last first: the one raised is the first by index, as a
     loop raises it. An exception that cannot be rebuilt in the parent arrives as its type
-    and message, not as a dead worker."""
+    and message, not as a dead worker, also where a package has made exceptions pickle
+    their context (tblib's reducers, which importing dask.distributed installs: the
+    condition under which the full suite first met it)."""
+    import distributed  # noqa: F401
+
     class Odd(Exception):
         def __init__(self, a, b):  # pickles, but cannot be rebuilt from its args
             super().__init__(f"odd {a} {b}")

@@ -169,6 +169,7 @@ def main(argv=None) -> int:
     if args.jobs < 1:
         print(f"derive: --jobs must be at least 1, got {args.jobs}", file=sys.stderr)
         return 2
+    parallel.JOBS = args.jobs  # the pipeline's own side-by-side steps take it from there
     for name in args.models:
         if name not in MODELS:
             print(f"derive: unknown model {name!r}; known: {', '.join(MODELS)}", file=sys.stderr)

@@ -30,6 +30,7 @@ from multiprocessing.reduction import ForkingPickler
 from typing import Callable
 
 _TASK: list[Callable[[int], object]] = []  # the task of the innermost pmap, for the forked workers
+JOBS = 1  # the cores the derivation may use (python -m derive --jobs): where pmap and later take it
 _PR_SET_PDEATHSIG = 1
 
 
@@ -84,6 +85,54 @@ def _run(i: int):
     raise RuntimeError(message)  # raised outside the handler: no context to carry along
 
 
+def _pool(workers: int) -> cf.ProcessPoolExecutor:
+    return cf.ProcessPoolExecutor(workers, mp_context=mp.get_context("fork"),
+                                  initializer=_tie_to_parent, initargs=(os.getpid(),))
+
+
+def _died(exc) -> WorkerDied:
+    return WorkerDied(f"a worker process ended without its result ({exc}); try --jobs 1")
+
+
+class later:
+    """fn() beside what this process does next, in a forked worker, where JOBS > 1 (and
+    workers can be tied to their parent); else now, here. result() gives its value (or
+    raises its exception, or WorkerDied), waiting for it; `beside` says which it was."""
+
+    def __init__(self, fn: Callable[[], object]):
+        self._future = self._ex = None
+        if JOBS > 1 and can_fork():
+            _TASK.append(lambda _: fn())
+            try:  # the fork method forks the worker within submit, with the task pushed
+                self._ex = _pool(1)
+                self._future = self._ex.submit(_run, 0)
+            except OSError:  # no process to be had: now, here
+                self._stop()
+            finally:
+                _TASK.pop()
+        self.beside = self._future is not None
+        if not self.beside:
+            self._value = fn()
+
+    def _stop(self) -> None:
+        left = list((getattr(self._ex, "_processes", None) or {}).values())
+        self._ex.shutdown(wait=False, cancel_futures=True)
+        for p in left:
+            if p.is_alive():
+                p.kill()
+        self._future = None
+
+    def result(self):
+        if not self.beside:
+            return self._value
+        try:
+            return self._future.result()
+        except cf.process.BrokenProcessPool as exc:
+            raise _died(exc) from None
+        finally:
+            self._ex.shutdown(wait=True)
+
+
 def pmap(task: Callable[[int], object], n: int, jobs: int, order: list[int] | None = None) -> list:
     """[task(0), ..., task(n - 1)], on up to `jobs` forked workers. `order` is the order in
     which the tasks are handed out (the longest first balances the workers best); the
@@ -97,8 +146,7 @@ def pmap(task: Callable[[int], object], n: int, jobs: int, order: list[int] | No
     if jobs <= 1 or n <= 1 or not can_fork():
         return [task(i) for i in range(n)]
     _TASK.append(task)
-    ex = cf.ProcessPoolExecutor(min(jobs, n), mp_context=mp.get_context("fork"),
-                                initializer=_tie_to_parent, initargs=(os.getpid(),))
+    ex = _pool(min(jobs, n))
     done = False
     try:
         try:
@@ -109,7 +157,7 @@ def pmap(task: Callable[[int], object], n: int, jobs: int, order: list[int] | No
         for i in range(n):
             exc = futures[i].exception()
             if isinstance(exc, cf.process.BrokenProcessPool):
-                raise WorkerDied(f"a worker process ended without its result ({exc}); try --jobs 1") from None
+                raise _died(exc) from None
             if exc is not None:
                 raise exc
         done = True

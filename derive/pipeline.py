@@ -19,7 +19,7 @@ import sympy as sp
 
 from derive import constraints, convert
 from derive import mechanics as mech
-from derive import names, nonsmooth
+from derive import names, nonsmooth, parallel
 from derive.model import TIME, Function, Load, Model, Unsupported
 
 P_SYMBOL = sp.Symbol("p")  # the operator d/dt
@@ -401,10 +401,17 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
     if kinks.kinks:  # where the non-smooth terms leave an entry without a derivative
         undefined = [nonsmooth.undefined_where(kinks, E, xs, reference, model.name) for xs in (rqdd, rqd, rq)]
 
-    with steps("the two routes agree (30 digits, random rational points)"):
-        agreement = compare_operators(op1, op2)
+    def agree(agreement: float) -> float:
         if agreement > 1e-25:
             raise AssertionError(f"routes 1 and 2 disagree: {agreement:.3e}")
+        return agreement
+
+    # a check that nothing below needs until the metadata: beside the next steps where the
+    # derivation has more than one core (derive.parallel.JOBS), else here
+    with steps("the two routes agree (30 digits, random rational points)"
+               + (", beside the next steps" if parallel.JOBS > 1 and parallel.can_fork() else "")):
+        check = parallel.later(lambda: compare_operators(op1, op2))
+        agreement = None if check.beside else agree(check.result())
 
     deriv = Derivation(model=model, mass_matrix=Mq, forcing=f, routhian=R, rq=rq, rqd=rqd,
                        rqdd=rqdd, even=even, equilibrium_residual=residual, operator=op2,
@@ -440,6 +447,9 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
             scaled = sp.Matrix(len(order), len(order), lambda i, j: sp.expand(J[i, j] / scale[i]))
             deriv.variants[vname] = VariantResult(opv, blk, polys, scaled)
 
+    if check.beside:
+        with steps("the two routes agree: the check beside the steps above"):
+            deriv.route_agreement = agree(check.result())
     deriv.timings = steps.timings
     if moving and kinks.kinks:  # a kink's argument with the parameter time-varying too
         for key in ("mass_matrix", "forcing"):
@@ -505,6 +515,9 @@ def functions(d: Derivation) -> list[Function]:
     contributes its own, in the kinds' order."""
     from derive import outputs
 
+    # in this process: built in a worker and pickled back, SymPy's expressions come back
+    # equal but not always in the same form, and their CSE then differs (tried: 1019
+    # against 1026 operations in one function)
     fns = []
     for kind in outputs.kinds():
         fns.extend(kind.functions(d))

@@ -224,3 +224,43 @@ def test_a_worker_killed_is_reported_not_waited_for():
     with pytest.raises(parallel.WorkerDied, match="without its result"):
         parallel.pmap(task, 3, 2)
     assert parallel._TASK == []
+
+
+def test_later_runs_beside_with_jobs_and_here_without(monkeypatch):
+    """parallel.later: with JOBS > 1 in a worker (another pid), its value or its exception
+    at result(); with one job, now and here."""
+    def boom():
+        raise ArithmeticError("routes disagree")
+
+    for jobs in (2, 1):
+        monkeypatch.setattr(parallel, "JOBS", jobs)
+        job = parallel.later(os.getpid)
+        assert job.beside == (jobs > 1 and parallel.can_fork())
+        assert (job.result() != os.getpid()) == job.beside
+        if jobs > 1:
+            failing = parallel.later(boom)
+            with pytest.raises(ArithmeticError, match="routes disagree"):
+                failing.result()
+        else:
+            with pytest.raises(ArithmeticError, match="routes disagree"):
+                parallel.later(boom)
+
+
+def test_the_routes_check_beside_the_next_steps_still_stops_a_disagreement(monkeypatch):
+    """The comparison of the two routes run beside the later steps (JOBS 2): a disagreement
+    still stops the derivation, as it does run in its place; an agreement is the same
+    number in the metadata either way."""
+    from derive import pipeline
+    from derive.models import gimbal_gyroscope as gg
+
+    out = {}
+    for jobs in (2, 1):
+        monkeypatch.setattr(parallel, "JOBS", jobs)
+        d = pipeline.derive(gg.build(), pipeline.Steps(out=open(os.devnull, "w")))
+        out[jobs] = pipeline.metadata(d)["route_agreement"]
+    assert out[2] == out[1] is not None
+    monkeypatch.setattr(pipeline, "compare_operators", lambda a, b: 1.0)
+    for jobs in (2, 1):
+        monkeypatch.setattr(parallel, "JOBS", jobs)
+        with pytest.raises(AssertionError, match="routes 1 and 2 disagree"):
+            pipeline.derive(gg.build(), pipeline.Steps(out=open(os.devnull, "w")))

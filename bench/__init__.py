@@ -6,9 +6,10 @@ from __future__ import annotations
 def machine() -> dict:
     """What a run was measured on: Python, the processor's architecture, model name and
     family/model/stepping, the kernel's bogomips and the cores. The machine is shared and
-    virtual: within one session the same code measured up to 1.6x apart in absolute time
-    (LAPACK's eigvals of the bench's companion 62.7-99 us a set), which is why every figure
-    is a ratio against a baseline of the same run, and a record says where it came from."""
+    virtual: the same code measured up to 1.8x apart in absolute time within a quarter of an
+    hour (LAPACK's eigvals of the bench's companion 68.8-123.8 us a set), which is why every
+    figure is a ratio against a baseline of the same run, and a record says where it came
+    from."""
     import os
     import platform
 

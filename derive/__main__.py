@@ -131,10 +131,16 @@ def _source_size(module) -> int:
         return 0
 
 
-def _derive_one(module, model, out: Path, jobs: int) -> str | None:
-    """Derive and emit one model into out/<name>/, each step with its time on stderr.
-    Returns None, or the one line that says why it failed."""
-    name = model.name if model else module.__name__.rsplit(".", 1)[-1]
+def _name(module, model) -> str:
+    """A job's model name: the built model's, or a seed model's module name (its own)."""
+    return model.name if model else module.__name__.rsplit(".", 1)[-1]
+
+
+def _derive_one(module, model, out: Path) -> str | None:
+    """Derive and emit one model into out/<name>/, each step with its time on stderr, its
+    emission shared out as derive.parallel.JOBS says. Returns None, or the one line that
+    says why it failed."""
+    name = _name(module, model)
     steps = pipeline.Steps(prefix=f"[{name}] ")
     try:
         with steps("model: energies and parameters"):
@@ -144,7 +150,7 @@ def _derive_one(module, model, out: Path, jobs: int) -> str | None:
             with steps("functions to emit"):
                 fns = pipeline.functions(deriv)
             with steps("emit: CSE, CasADi, NumPy, mpmath, C through the templates"):
-                files = emit.emit(model, fns, pipeline.metadata(deriv), out / model.name, jobs=jobs)
+                files = emit.emit(model, fns, pipeline.metadata(deriv), out / model.name)
     except (Unsupported, NotAModel) as exc:
         msg = str(exc) if str(exc).startswith(f"{name}: ") else f"{name}: {exc}"
         return msg.splitlines()[0] if msg else msg
@@ -169,7 +175,14 @@ def main(argv=None) -> int:
     if args.jobs < 1:
         print(f"derive: --jobs must be at least 1, got {args.jobs}", file=sys.stderr)
         return 2
-    parallel.JOBS = args.jobs  # the pipeline's own side-by-side steps take it from there
+    before, parallel.JOBS = parallel.JOBS, args.jobs  # where the derivation's workers take it from
+    try:
+        return _main(args)
+    finally:
+        parallel.JOBS = before  # called in a process that goes on (a session, a test)
+
+
+def _main(args) -> int:
     for name in args.models:
         if name not in MODELS:
             print(f"derive: unknown model {name!r}; known: {', '.join(MODELS)}", file=sys.stderr)
@@ -186,13 +199,13 @@ def main(argv=None) -> int:
             jobs.append((module, None))
     t_all = time.perf_counter()
     out = Path(args.out)
-    names = [model.name if model else module.__name__.rsplit(".", 1)[-1] for module, model in jobs]
+    names = [_name(module, model) for module, model in jobs]
     if args.jobs == 1 or len(set(names)) < len(names):
         # one at a time, stopping at the first that fails; and where two models of one name
         # go to one folder, so that the last one named is the one left there, as asked
         failures = []
         for module, model in jobs:
-            failures.append(_derive_one(module, model, out, args.jobs))
+            failures.append(_derive_one(module, model, out))
             if failures[-1]:
                 break
     else:
@@ -200,7 +213,7 @@ def main(argv=None) -> int:
         # times); the longest model file first, a rough measure of its work
         size = [_source_size(m) for m, _ in jobs]
         try:
-            failures = parallel.pmap(lambda i: _derive_one(*jobs[i], out, args.jobs), len(jobs), args.jobs,
+            failures = parallel.pmap(lambda i: _derive_one(*jobs[i], out), len(jobs),
                                      order=sorted(range(len(jobs)), key=lambda i: -size[i]))
         except parallel.WorkerDied as exc:  # killed (out of memory, a signal): no result to report
             print(f"derive: {exc}", file=sys.stderr)

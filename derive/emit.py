@@ -589,10 +589,10 @@ def environment() -> jinja2.Environment:
         keep_trailing_newline=True, autoescape=False)
 
 
-def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=None, jobs: int = 1) -> list[Path]:
+def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=None) -> list[Path]:
     """Write the generated package of one model into outdir (created, files overwritten).
-    With jobs > 1 the functions' CSE and printing are shared out among forked workers
-    (derive.parallel; the same files to the byte)."""
+    With more than one job (derive.parallel.JOBS) the functions' CSE and printing are shared
+    out among forked workers (the same files to the byte)."""
     import importlib
 
     import sys
@@ -616,7 +616,7 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
 
     # the largest first, so that the workers finish together
     size = [sum(len(mat) for _, mat in fn.outputs) for fn in functions]
-    done = parallel.pmap(one, len(functions), jobs, order=sorted(range(len(functions)), key=lambda i: -size[i]))
+    done = parallel.pmap(one, len(functions), order=sorted(range(len(functions)), key=lambda i: -size[i]))
     emitted = {k: [d[k] for d in done] for k in printers}
     source = _shown(module_file)
     common = dict(model=model.name, title=model.title, paper=model.source, source=source,

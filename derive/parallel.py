@@ -62,6 +62,11 @@ def can_fork() -> bool:
     return sys.platform.startswith("linux") and "fork" in mp.get_all_start_methods() and _prctl() is not None
 
 
+def beside() -> bool:
+    """Whether work goes to workers: more than one job (JOBS), and workers to be had."""
+    return JOBS > 1 and can_fork()
+
+
 def _tie_to_parent(parent: int) -> None:
     """A worker's initializer: killed when its parent dies (and at once if it already has)."""
     _prctl()(_PR_SET_PDEATHSIG, signal.SIGKILL)
@@ -94,6 +99,16 @@ def _died(exc) -> WorkerDied:
     return WorkerDied(f"a worker process ended without its result ({exc}); try --jobs 1")
 
 
+def _stop(ex: cf.ProcessPoolExecutor) -> None:
+    """The pool shut down with no worker left behind (one waiting on a pool that broke or
+    never filled is killed)."""
+    left = list((getattr(ex, "_processes", None) or {}).values())
+    ex.shutdown(wait=False, cancel_futures=True)
+    for p in left:
+        if p.is_alive():
+            p.kill()
+
+
 class later:
     """fn() beside what this process does next, in a forked worker, where JOBS > 1 (and
     workers can be tied to their parent); else now, here. result() gives its value (or
@@ -101,26 +116,19 @@ class later:
 
     def __init__(self, fn: Callable[[], object]):
         self._future = self._ex = None
-        if JOBS > 1 and can_fork():
+        if beside():
             _TASK.append(lambda _: fn())
             try:  # the fork method forks the worker within submit, with the task pushed
                 self._ex = _pool(1)
                 self._future = self._ex.submit(_run, 0)
             except OSError:  # no process to be had: now, here
-                self._stop()
+                _stop(self._ex)
+                self._future = None
             finally:
                 _TASK.pop()
         self.beside = self._future is not None
         if not self.beside:
             self._value = fn()
-
-    def _stop(self) -> None:
-        left = list((getattr(self._ex, "_processes", None) or {}).values())
-        self._ex.shutdown(wait=False, cancel_futures=True)
-        for p in left:
-            if p.is_alive():
-                p.kill()
-        self._future = None
 
     def result(self):
         if not self.beside:
@@ -133,8 +141,8 @@ class later:
             self._ex.shutdown(wait=True)
 
 
-def pmap(task: Callable[[int], object], n: int, jobs: int, order: list[int] | None = None) -> list:
-    """[task(0), ..., task(n - 1)], on up to `jobs` forked workers. `order` is the order in
+def pmap(task: Callable[[int], object], n: int, jobs: int | None = None, order: list[int] | None = None) -> list:
+    """[task(0), ..., task(n - 1)], on up to `jobs` forked workers (default JOBS). `order` is the order in
     which the tasks are handed out (the longest first balances the workers best); the
     results are returned in index order whatever it is. Where tasks raise, the exception of
     the first by index is raised here, after the others have ended, as a loop would raise
@@ -143,6 +151,7 @@ def pmap(task: Callable[[int], object], n: int, jobs: int, order: list[int] | No
     order = list(range(n)) if order is None else list(order)
     if sorted(order) != list(range(n)):
         raise ValueError("order: not a permutation of the tasks")
+    jobs = JOBS if jobs is None else jobs
     if jobs <= 1 or n <= 1 or not can_fork():
         return [task(i) for i in range(n)]
     _TASK.append(task)
@@ -166,9 +175,5 @@ def pmap(task: Callable[[int], object], n: int, jobs: int, order: list[int] | No
         _TASK.pop()
         if done:
             ex.shutdown(wait=True)
-        else:  # no worker left behind: one waiting on a pool that broke or never filled
-            left = list((getattr(ex, "_processes", None) or {}).values())
-            ex.shutdown(wait=False, cancel_futures=True)
-            for p in left:
-                if p.is_alive():
-                    p.kill()
+        else:
+            _stop(ex)

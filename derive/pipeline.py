@@ -409,7 +409,7 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
     # a check that nothing below needs until the metadata: beside the next steps where the
     # derivation has more than one core (derive.parallel.JOBS), else here
     with steps("the two routes agree (30 digits, random rational points)"
-               + (", beside the next steps" if parallel.JOBS > 1 and parallel.can_fork() else "")):
+               + (", beside the next steps" if parallel.beside() else "")):
         check = parallel.later(lambda: compare_operators(op1, op2))
         agreement = None if check.beside else agree(check.result())
 

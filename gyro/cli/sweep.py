@@ -60,11 +60,8 @@ def run(args) -> int:
     elif out is not None:
         print(result.summary(out))
     else:
-        f = result.spectrum.frequencies
-        print(f"{'':>4} {args.x + ' [' + result.xunit + ']':>16} " + " ".join(f"{'omega' + str(j + 1):>12}" for j in range(f.shape[1])))
-        for i, xv in enumerate(result.x):
-            print(f"{i + 1:>4} {xv:>16.8g} " + " ".join(f"{w:>12.6g}" for w in f[i]))
+        print(result.table())
     if not np.all(np.isfinite(result.spectrum.frequencies)):
-        print("gyro: some values have no finite spectrum (NaN above)", file=sys.stderr)
+        print("gyro: some values have no finite spectrum (failed above)", file=sys.stderr)
         return 1
     return 0

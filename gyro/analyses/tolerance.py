@@ -161,10 +161,11 @@ def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: i
     depend on it: the random streams come in blocks of STREAM)."""
     from gyro.analyses.sensitivity import sensitivities
 
+    # by the declared names (another name taken for a parameter, as lambda for lam, too)
+    spreads = [Spread(model.param_name(s.name, "--spread"), s.kind, s.width) for s in spreads]
+    pairs = {(model.canonical(a), model.canonical(b)): rho for (a, b), rho in (pairs or {}).items()}
     names = [s.name for s in spreads]
     for s in spreads:
-        if s.name not in model.param_names:
-            raise ParameterError(f"--spread {s.name}: unknown parameter; known: {' '.join(model.param_names)}")
         if values[s.name] == 0:
             raise ParameterError(f"--spread {s.name}: its value is 0, so a relative spread moves nothing")
     if len(set(names)) != len(names):

@@ -7,7 +7,7 @@ D1,D2,D3,D4] [--method NAME] [--json] [--out FILE.png]`: a motion of the gyrohor
 from its relative equilibrium (3.1), the angles alpha, beta, gamma, epsilon moved by D1..D4
 rad (at rest), by integrating the emitted (1.5)-(1.6) (default DOP853; `projected`: fixed
 steps of DOP853's tableau projected onto E = E(0)); E (2.3) along it. Parameters:
-A B C J L I nu zeta eta lambda (lambda defaults to 1 + chi).
+A B C J L I nu zeta eta lam (or lambda; it defaults to 1 + chi).
 
 `gyro simulate gimbal_precession --level {full,rigorous,image,small,elementary} --t-end T
 [--points N] [--set NAME=VALUE]... [--base-rate NAME=AMP:FREQ[:PHASE]]... [--json] [--out
@@ -77,10 +77,11 @@ def parse(args):
     model = load(args.model)
     ic = {p.name: p for p in _initial_params()}
     sets = parse_sets(args.set)
-    known = [*model.param_names, *ic]
+    known = [*model.param_names, *model.aliases, *ic]
     for key in sets:
         if key not in known:
-            raise ParameterError(f"unknown parameter {key!r} for {model.name}; known: {' '.join(known)}")
+            raise ParameterError(f"unknown parameter {key!r} for {model.name}; known: {model.known_names()} "
+                                 f"{' '.join(ic)}")
     values = model.parameters({k: v for k, v in sets.items() if k not in ic})
     init = {}
     for name, p in ic.items():

@@ -37,8 +37,7 @@ def run(args) -> int:
 
     model = model_with_equilibrium(args.model)
     values = model.parameters(parse_sets(args.set))
-    if args.x not in model.param_names:
-        raise ParameterError(f"--x {args.x!r}: unknown parameter; known: {' '.join(model.param_names)}")
+    args.x = model.param_name(args.x, "--x")  # the declared name (another name taken for it too)
     lo, hi = args.x_range
     if not lo < hi or not (math.isfinite(lo) and math.isfinite(hi)):
         raise ParameterError(f"--x-range: need finite LO < HI, got {lo} {hi}")

@@ -241,7 +241,7 @@ class CampbellDiagram:
         if t is None:
             return
         zeta = t.damping_ratio()
-        grows = self.growing().any()
+        grows, labelled = self.growing().any(), set()
         damped = (t.damped or grows) and np.any(np.nan_to_num(np.abs(zeta)) > 0)
         norm, cmap = None, "viridis"
         if damped and grows:  # a scale through zero: growing roots (zeta < 0) red, decaying blue
@@ -252,8 +252,11 @@ class CampbellDiagram:
         shapes = {"forward": "^", "backward": "v", "mixed": "o"}
         every = max(1, len(W) // 40)  # markers at about 40 spins
         sc = None
-        for kind, marker in shapes.items():
+        growing = self.growing()
+        # the growing roots' markers last, over a decaying root at the same frequency
+        for top, (kind, marker) in [(g, km) for g in (False, True) for km in shapes.items()]:
             sel = (self.whirl == kind) if self.whirl is not None else np.zeros(t.frequencies.shape, bool)
+            sel &= growing if top else ~growing
             sel[np.arange(len(W)) % every != 0] = False
             ii, jj = np.nonzero(sel)
             if not ii.size:
@@ -261,11 +264,14 @@ class CampbellDiagram:
             c = zeta[ii, jj] if damped else "k"
             sc = ax.scatter(W[ii], t.frequencies[ii, jj], c=c, marker=marker, s=22, cmap=cmap, norm=norm,
                             vmin=float(np.nanmin(zeta)) if damped and norm is None else None,
-                            vmax=float(np.nanmax(zeta)) if damped and norm is None else None, zorder=3,
-                            edgecolors="none", label=f"{kind} whirl")
+                            vmax=float(np.nanmax(zeta)) if damped and norm is None else None, zorder=3.5 if top else 3,
+                            edgecolors="none", label=f"{kind} whirl" if kind not in labelled else None)
+            labelled.add(kind)
         if damped and sc is not None:
-            plt.colorbar(sc, ax=ax, label="damping ratio zeta" + (" (< 0: the root grows)" if grows else ""),
-                         shrink=0.8)
+            bar = plt.colorbar(sc, ax=ax, label="damping ratio zeta" + (" (< 0: the root grows)" if grows else ""),
+                               shrink=0.8)
+            if norm is not None:  # ticks on both sides of zero (each side has half the bar)
+                bar.set_ticks(np.unique(np.r_[np.linspace(norm.vmin, 0, 3), np.linspace(0, norm.vmax, 4)]))
         for k in self.harmonics:
             ax.plot(W, k * W, color="tab:orange", lw=1.0, ls="--")
             ax.annotate(f"{k}x", (W[-1], k * W[-1]), xytext=(3, 0), textcoords="offset points",

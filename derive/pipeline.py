@@ -300,6 +300,7 @@ def _varying_equations(model: Model, L, Q, given, varying: list, signals: list) 
 def derive(model: Model, steps: Steps | None = None) -> Derivation:
     steps = steps or Steps()
     model = convert.convert(model)  # dynamicsymbols, assumptions, vectors: the machinery's symbols
+    _refuse_nonholonomic(model)  # before anything is solved
     model, varying, all_signals = _split_varying(model)
     eliminated = {}
     if model.speeds and model.holonomic:

@@ -89,6 +89,9 @@ class Derivation:
     # in them, as KanesMethod forms them: {"u", "kinematics": q_d = V u + v, "mass_matrix",
     # "forcing": mass_matrix u_d = forcing in (q, u)} (speeds_equations)
     speeds: dict = field(default_factory=dict)
+    # non-smooth terms whose derivative the operator or B needs: term -> its argument at
+    # the reference ("0": the reference sits on the kink, the operator exists at no set)
+    nondifferentiable: dict = field(default_factory=dict)
 
     @property
     def momenta(self) -> list:
@@ -467,6 +470,7 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
         _thawed(deriv, kinks, reference, undefined)
     deriv.model = source
     deriv.constraints = eliminated
+    deriv.nondifferentiable = dict(kinks.nondifferentiable)
     if source.speeds:
         with steps("equations in the speeds of the kinematic equations (Kane's form)"):
             deriv.speeds = speeds_equations(source, deriv.mass_matrix, deriv.forcing)
@@ -583,6 +587,9 @@ def metadata(d: Derivation) -> dict:
     }
     if d.constraints:
         meta["constraints"] = d.constraints
+    if d.nondifferentiable:
+        meta["nondifferentiable"] = [{"term": t, "argument_at_reference": a}
+                                     for t, a in sorted(d.nondifferentiable.items())]
     if model.aliases:
         unknown = sorted(set(model.aliases.values()) - {p.name for p in model.parameters})
         if unknown:

@@ -85,6 +85,13 @@ class Derivation:
     # "forcing": the full equations with those parameters the signals' values, "sub":
     # parameter symbol -> the signal's value}; empty for a model without them
     varying: dict = field(default_factory=dict)
+    # a model given in speeds u with kinematic equations (Model.kinematics): its equations
+    # in them, as KanesMethod forms them: {"u", "kinematics": q_d = V u + v, "mass_matrix",
+    # "forcing": mass_matrix u_d = forcing in (q, u)} (speeds_equations)
+    speeds: dict = field(default_factory=dict)
+    # non-smooth terms whose derivative the operator or B needs: term -> its argument at
+    # the reference ("0": the reference sits on the kink, the operator exists at no set)
+    nondifferentiable: dict = field(default_factory=dict)
 
     @property
     def momenta(self) -> list:
@@ -296,8 +303,12 @@ def _varying_equations(model: Model, L, Q, given, varying: list, signals: list) 
 def derive(model: Model, steps: Steps | None = None) -> Derivation:
     steps = steps or Steps()
     model = convert.convert(model)  # dynamicsymbols, assumptions, vectors: the machinery's symbols
+    _refuse_nonholonomic(model)  # before anything is solved
     model, varying, all_signals = _split_varying(model)
     eliminated = {}
+    if model.speeds and model.holonomic:
+        raise Unsupported(f"{model.name}: kinematic equations together with holonomic constraints: write the "
+                          "model in its independent coordinates, or in their rates")
     if model.holonomic:
         with steps("holonomic constraints: dependent coordinates solved for, or multipliers"):
             found = constraints.solve_dependent(model)
@@ -459,7 +470,32 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
         _thawed(deriv, kinks, reference, undefined)
     deriv.model = source
     deriv.constraints = eliminated
+    deriv.nondifferentiable = dict(kinks.nondifferentiable)
+    if source.speeds:
+        with steps("equations in the speeds of the kinematic equations (Kane's form)"):
+            deriv.speeds = speeds_equations(source, deriv.mass_matrix, deriv.forcing)
     return deriv
+
+
+def speeds_equations(model: Model, Mq: sp.Matrix, f: sp.Matrix) -> dict:
+    """The equations Mq q'' = f in the speeds u of the kinematic equations, q' = V u + v:
+    with q'' = V u' + V' u + v' (V' and v' along the motion), premultiplied by V^T, which
+    is what Kane's equations are (the partial velocities of u_r are those of q' taken
+    through V's column r): V^T Mq V u' = V^T (f - Mq (V' u + v')), q' replaced by V u + v.
+    Refused with holonomic constraints (eliminated coordinates change the rates)."""
+    sp_ = model.speeds
+    u, V, v = sp.Matrix(sp_["u"]), sp_["V"], sp_["v"]
+    q, qd = model.q, model.qd
+    rate = {a: b for a, b in zip(qd, V * u + v)}
+
+    def dt(X):
+        return sum((X.diff(x) * r for x, r in zip(q, qd)), X.diff(TIME))
+
+    Vu = V.xreplace(rate)
+    accel = (dt(V) * u + dt(v)).xreplace(rate)
+    M = (Vu.T * Mq.xreplace(rate) * Vu).applyfunc(sp.expand)
+    F = (Vu.T * (f.xreplace(rate) - Mq.xreplace(rate) * accel)).applyfunc(sp.expand)
+    return {"u": list(u), "kinematics": (V * u + v), "mass_matrix": M, "forcing": F}
 
 
 def _with_multipliers(model: Model, steps: Steps) -> Derivation:
@@ -467,6 +503,9 @@ def _with_multipliers(model: Model, steps: Steps) -> Derivation:
     with steps("checks: names, what the machinery supports"):
         names.check_model(model)
         _refuse_nonholonomic(model)
+        if model.speeds:
+            raise Unsupported(f"{model.name}: kinematic equations together with holonomic constraints that "
+                              "need multipliers")
         Q = generalized_forces(model)
         exprs = [sp.sympify(model.lagrangian)] + [sp.sympify(x) for x in (Q or [])]
         if any(e.has(*NONSMOOTH) for e in exprs):
@@ -548,6 +587,9 @@ def metadata(d: Derivation) -> dict:
     }
     if d.constraints:
         meta["constraints"] = d.constraints
+    if d.nondifferentiable:
+        meta["nondifferentiable"] = [{"term": t, "argument_at_reference": a}
+                                     for t, a in sorted(d.nondifferentiable.items())]
     if model.aliases:
         unknown = sorted(set(model.aliases.values()) - {p.name for p in model.parameters})
         if unknown:

@@ -18,7 +18,7 @@ MODEL = "torsion_gyrocompass"
 TIERS = {
     "unit": ("test_mechanics", "test_machinery", "test_architecture", "test_results", "test_model_namespace"),
     "generated": ("test_generated", "test_textbook", "test_docs_models", "test_derivation", "test_docs_api",
-                  "test_mechanics_style", "test_derive_baselines", "test_parallel_derive"),
+                  "test_mechanics_style", "test_speeds", "test_closed_chains", "test_derive_baselines", "test_parallel_derive"),
     "paper": ("test_paper", "test_anchors", "test_nonlinear", "test_gimbal", "test_gimbal_closed_form",
               "test_gimbal_section6", "test_gimbal_paper_items", "test_paper_items",
               "test_gyrohorizoncompass", "test_verdict", "test_ghc_paper_items", "test_ghc_motion", "test_precession",
@@ -28,8 +28,8 @@ TIERS = {
                 "test_equilibrium_c"),
     "properties": ("test_properties",),
     "cli": ("test_cli", "test_gimbal_simulate", "test_readme", "test_sweep", "test_wheel", "test_ghc_cli", "test_fuzz", "test_robustness",
-            "test_tolerance", "test_executor", "test_precession_cli", "test_forced", "test_unbalance_lagrangian",
-            "test_campbell_stability", "test_param_names"),
+            "test_tolerance", "test_executor", "test_motion_generic", "test_precession_cli", "test_forced",
+            "test_unbalance_lagrangian", "test_campbell_stability", "test_param_names"),
 }
 _TIER_OF = {f: tier for tier, files in TIERS.items() for f in files}
 

@@ -38,6 +38,7 @@ from itertools import combinations
 import sympy as sp
 
 from derive import mechanics as mech
+from derive.derivation import Derivation
 from derive.model import TIME, Load, Model, Unsupported
 
 
@@ -132,7 +133,6 @@ def _tidy(e):
 
 def multipliers(model: Model, Q, steps):
     """The derivation with Lagrange multipliers (module docstring)."""
-    from derive.pipeline import Derivation  # the one result type
 
     phis = _constraints(model)
     m, n = len(phis), len(model.q)

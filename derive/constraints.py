@@ -123,14 +123,6 @@ def eliminate(model: Model, deps: list, sol: dict) -> tuple[Model, dict]:
     return out, info
 
 
-def _tidy(e):
-    """An entry of the reduced operator in bounded work: products of the constraint
-    Jacobian's inverse expanded and cancelled as a rational function of its sines and
-    cosines (sp.simplify took 20 s on a four-bar linkage's entries; the values are the
-    same: tests/test_closed_chains.py holds them to sympy's linearize)."""
-    return sp.cancel(sp.expand(e))
-
-
 def multipliers(model: Model, Q, steps):
     """The derivation with Lagrange multipliers (module docstring)."""
 
@@ -180,10 +172,10 @@ def multipliers(model: Model, Q, steps):
         for j, phi in enumerate(phis):
             H += lam0[j] * sp.hessian(phi, q)
         E0 = E.subs({s: 0 for s in zero_inputs})
-        Mr = (C.T * E0.jacobian(qdd).subs(rest) * C).applyfunc(_tidy)
-        Dr = (C.T * E0.jacobian(qd).subs(rest) * C).applyfunc(_tidy)
-        Kr = (C.T * (E0.jacobian(q).subs(rest) + H) * C).applyfunc(_tidy)
-        residual = (C.T * f0).applyfunc(_tidy)
+        Mr = (C.T * E0.jacobian(qdd).subs(rest) * C)
+        Dr = (C.T * E0.jacobian(qd).subs(rest) * C)
+        Kr = (C.T * (E0.jacobian(q).subs(rest) + H) * C)
+        residual = (C.T * f0)
         op = mech.LinearOperator(Mr, Dr, Kr)
     rq = [q[i] for i in ind]
     d = Derivation(model=model, mass_matrix=Maug, forcing=faug, routhian=model.lagrangian, rq=rq,
@@ -193,7 +185,7 @@ def multipliers(model: Model, Q, steps):
     w = list(model.input_signal_symbols)
     if w:
         Bq = -E.jacobian(w).subs(rest)
-        B = (C.T * Bq).applyfunc(_tidy)
+        B = (C.T * Bq)
         keep = [j for j in range(len(w)) if any(B[i, j] != 0 for i in range(B.rows))]
         d.inputs = [w[j] for j in keep]
         d.input_matrix = B.extract(list(range(B.rows)), keep) if keep else None

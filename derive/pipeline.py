@@ -425,8 +425,8 @@ def speeds_equations(model: Model, Mq: sp.Matrix, f: sp.Matrix) -> dict:
 
     Vu = V.xreplace(rate)
     accel = (dt(V) * u + dt(v)).xreplace(rate)
-    M = (Vu.T * Mq.xreplace(rate) * Vu).applyfunc(sp.expand)
-    F = (Vu.T * (f.xreplace(rate) - Mq.xreplace(rate) * accel)).applyfunc(sp.expand)
+    M = Vu.T * Mq.xreplace(rate) * Vu  # as they come: expanding took a top's 0.6 s
+    F = Vu.T * (f.xreplace(rate) - Mq.xreplace(rate) * accel)
     return {"u": list(u), "kinematics": (V * u + v), "mass_matrix": M, "forcing": F}
 
 

@@ -83,6 +83,12 @@ def _groups(model: Model) -> np.ndarray:
 def equilibria(model: Model, P: np.ndarray, tol: float = TOL, max_iter: int = MAX_ITER):
     """Relative equilibria of a batch P (sets, parameters). Returns (qe, ok): qe (sets,
     equilibrium coordinates), NaN where ok is False."""
+    qe, ok, _ = _equilibria(model, P, tol, max_iter)
+    return qe, ok
+
+
+def _equilibria(model: Model, P, tol=TOL, max_iter=MAX_ITER):
+    """equilibria, and _solve's report of each set."""
     require_time_free(model)
     P = np.atleast_2d(np.asarray(P, dtype=float))
     names, idx, is_angle = _layout(model)
@@ -93,14 +99,8 @@ def equilibria(model: Model, P: np.ndarray, tol: float = TOL, max_iter: int = MA
         qe = np.where(np.isfinite(qe), qe, 0.0)  # (2.2) divides by g: at g = 0 start from zero
     else:
         qe = np.zeros((n, len(names)))
-    qe, converged = _newton(model, P, qe, idx, is_angle, tol, max_iter)
+    qe, ok, report = _solve(model, P, qe, idx, is_angle, tol, max_iter)
     resid = function(model, "equilibrium_residual")
-    ok = np.all(np.isfinite(qe), axis=1) & converged
-    late = np.flatnonzero(~converged & np.all(np.isfinite(qe), axis=1))
-    if late.size:  # not converged in max_iter: an exact equilibrium that Newton circles
-        with np.errstate(all="ignore"):
-            r = resid(P[late], qe[late])[0].reshape(late.size, -1)[:, idx]
-        ok[late] = np.max(np.abs(r), axis=1, initial=0.0) <= 1e-9 * (1 + np.max(np.abs(P[late]), axis=1))
     steady = [model.meta["reduced"].index(c) for c in model.meta.get("steady", {})]
     if steady and ok.any():  # a steady coordinate's row: no unknown enters it, it must hold itself
         k = np.flatnonzero(ok)
@@ -109,7 +109,96 @@ def equilibria(model: Model, P: np.ndarray, tol: float = TOL, max_iter: int = MA
         ok[k] = np.max(np.abs(r), axis=1) <= 1e-9 * (1 + np.max(np.abs(P[k]), axis=1))
     qe = np.where(is_angle, wrap(qe), qe)
     qe[~ok] = np.nan
-    return qe, ok
+    return qe, ok, report
+
+
+def _solve(model: Model, P, q0, idx, is_angle, tol, max_iter):
+    """Newton from the starts q0, every answer checked (residual_test), and the sets where
+    Newton came to rest without balancing the equations tried again from other starts
+    (RESTARTS). Returns (qe, ok, report): qe as Newton left it (NaN where an iterate was not
+    finite), ok where it is an equilibrium, report (residual_test's ratio, row and value,
+    and the point) of the first try of each set."""
+    qe, converged = _newton(model, P, q0.copy(), idx, is_angle, tol, max_iter)
+    finite = np.all(np.isfinite(qe), axis=1)
+    ratio, row, value = residual_test(model, P, qe, idx)
+    balanced = ratio <= RESIDUAL_TOL
+    # not converged in max_iter: an exact equilibrium that Newton circles, accepted by its
+    # residual as before (absolute, as it always was) and by the residual test
+    ok = finite & balanced & converged
+    late = np.flatnonzero(~converged & finite & balanced)
+    if late.size:
+        with np.errstate(all="ignore"):
+            r = function(model, "equilibrium_residual")(P[late], qe[late])[0].reshape(late.size, -1)[:, idx]
+        ok[late] = np.max(np.abs(r), axis=1, initial=0.0) <= 1e-9 * (1 + np.max(np.abs(P[late]), axis=1))
+    report = {"ratio": ratio, "row": row, "value": value, "q": qe.copy()}
+    # Newton that could not start: it "converged" (a zero least-squares step along the null
+    # direction of a singular K) where the equations do not hold; again from other starts
+    stuck = np.flatnonzero(converged & finite & ~balanced & np.all(np.isfinite(P), axis=1))
+    for shift in RESTARTS:
+        if stuck.size == 0:
+            break
+        start = _moved_start(q0[stuck], is_angle, shift)
+        q, conv = _newton(model, P[stuck], start, idx, is_angle, tol, max_iter)
+        good = conv & np.all(np.isfinite(q), axis=1)
+        good &= residual_test(model, P[stuck], q, idx)[0] <= RESIDUAL_TOL
+        take = stuck[good]
+        qe[take], ok[take] = q[good], True
+        stuck = stuck[~good]
+    return qe, ok, report
+
+
+# A residual below RESIDUAL_TOL of the size of the terms that make it up is an equilibrium
+# found to rounding: at the answer of Newton's iteration (steps below TOL = 1e-14 of the
+# coordinates) the residual is the rounding of evaluating it, a few hundred operations each
+# erring by at most u = 1.1e-16 of the terms it combines (~1e-13 of them), plus K dq, at most
+# TOL |K| |q| (~1e-14 of them). 1e-8 is five orders above that, and a point whose equations
+# miss by more than 1e-8 of their own terms is no equilibrium that rounding explains (the
+# cubic spring at x = 0 misses by all of its terms, ratio 1).
+RESIDUAL_TOL = 1e-8
+# starts tried where Newton could not start: the first start moved by these fractions of
+# its own coordinates, or by these amounts in the coordinate's units where it is zero
+# (angles by at most 1 rad), each with alternating signs over the coordinates, then the
+# opposite signs; the first start that ends on an equilibrium answers
+RESTARTS = (1e-3, -1e-3, 1e-1, -1e-1, 1.0, -1.0, 10.0, -10.0)
+
+
+def _moved_start(q0, is_angle, shift):
+    sign = np.where(np.arange(q0.shape[1]) % 2 == 0, 1.0, -1.0)
+    step = np.where(q0 != 0, np.abs(q0) * shift, shift) * sign
+    step = np.where(is_angle, np.clip(step, -1.0, 1.0), step)
+    return q0 + step
+
+
+def residual_test(model: Model, P, qe, idx):
+    """Per set: (max_i |r_i| / T_i, the row i of that maximum, r_i), r the residual of the
+    equilibrium equations at qe and T_i the size of the terms row i combines, measured as
+    sum_j |p_j dr_i/dp_j| + sum_j |K_ij| |q_j|: each term of r_i that carries p_j (or q_j)
+    to the power d contributes d times itself to p_j dr_i/dp_j, so T_i is at least the
+    largest term unless terms of the same degree in every parameter and every coordinate
+    cancel. p dr/dp by a forward difference with the relative step 2^-20 (its rounding
+    about 1e-10 of T, its truncation about 1e-6: it is a scale, not a derivative). A row
+    whose terms are all zero (T_i = 0) has r_i = 0 exactly or no equilibrium: its ratio is
+    0 or inf. NaN coordinates: ratio inf."""
+    n, npar = P.shape
+    if n == 0 or len(idx) == 0:
+        return np.zeros(n), np.zeros(n, int), np.zeros(n)
+    with np.errstate(all="ignore"):
+        r, K = _system(model, idx)(P, qe)
+        T = np.einsum("bij,bj->bi", np.abs(K), np.abs(qe))
+        # the coordinates' part alone passes most sets (a regular K: r = K dq, dq below TOL
+        # |q|); the parameters' part, n_p more evaluations, only where it does not
+        late = np.flatnonzero(~np.all(np.abs(r) <= RESIDUAL_TOL * T, axis=1))
+        if late.size:
+            resid, h, m = function(model, "equilibrium_residual"), 2.0**-20, late.size
+            Pl = P[late]
+            Pall = np.concatenate([Pl * np.where(np.arange(npar) == j, 1 + h, 1.0) for j in range(npar)])
+            rall = resid(Pall, np.tile(qe[late], (npar, 1)))[0].reshape(npar, m, -1)[:, :, idx]
+            T[late] += np.sum(np.abs(rall - r[late]), axis=0) / h
+        ratio = np.where(np.abs(r) == 0, 0.0, np.abs(r) / T)
+    ratio = np.where(np.isfinite(ratio), ratio, np.inf)
+    row = np.argmax(ratio, axis=1)
+    k = np.arange(n)
+    return ratio[k, row], row, r[k, row]
 
 
 def _newton(model: Model, P, qe, idx, is_angle, tol, max_iter):
@@ -194,10 +283,24 @@ def _system(model: Model, idx):
 def equilibrium(model: Model, params) -> np.ndarray:
     """The relative equilibrium of one parameter set (metadata 'equilibrium_coordinates'),
     or EquilibriumError."""
-    qe, ok = equilibria(model, np.asarray(params, dtype=float)[None, :])
+    qe, ok, report = _equilibria(model, np.asarray(params, dtype=float)[None, :])
     if not ok[0]:
-        raise EquilibriumError("Newton's method did not converge")
+        raise EquilibriumError(why_not(model, report))
     return qe[0]
+
+
+def why_not(model: Model, report, k: int = 0) -> str:
+    """One line on why set k of a batch has no equilibrium: the equation that does not hold
+    at the last point tried, and by how much of the size of its terms."""
+    names = model.meta["equilibrium_coordinates"]
+    ratio, row, value, q = (report[key][k] for key in ("ratio", "row", "value", "q"))
+    if not np.all(np.isfinite(q)) or not names:
+        return "Newton's method did not converge (an iterate was not finite)"
+    at = ", ".join(f"{c} = {v:.6g}" for c, v in zip(names, q))
+    if ratio <= RESIDUAL_TOL:
+        return f"Newton's method did not converge (last at {at})"
+    return (f"the equation of {names[row]} keeps a residual of {value:.3g} at {at}, {ratio:.2g} of the "
+            f"size of its terms (an equilibrium leaves below {RESIDUAL_TOL:g}), and at every other start tried")
 
 
 def operators(model: Model, P: np.ndarray, qe: np.ndarray):

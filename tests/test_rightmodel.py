@@ -99,3 +99,120 @@ def test_free_fall_has_no_equilibrium():
         assert ok.tolist() == [False, True, False] and np.isnan(qe[[0, 2]]).all() and qe[1, 0] == 0.0
     rc, out, err = run_cli("frequencies", FALL, "--set", "g=0", "--json")
     assert rc == 0 and json.loads(out)["stability"]["class"] == "marginal", err
+
+
+# --------------------------------------------------------------------------- modes
+
+TOP = str(MODELS / "symmetric_top.py")
+TOP_DEFAULTS = dict(A=0.02, C=0.01, m=1.0, g=9.81, l=0.05)
+
+
+def top_roots(n, A, C, m, g, l):
+    """The tilt block's roots, (A p^2 - m g l)^2 + (C n p)^2 = 0 (tests/models/symmetric_top.py):
+    A p^2 -+ i C n p - m g l = 0, p = (+-i C n +- sqrt(4 A m g l - C^2 n^2)) / (2 A)."""
+    s = np.sqrt(complex(4 * A * m * g * l - (C * n) ** 2))
+    return np.array([(sa * 1j * C * n + sb * s) / (2 * A) for sa in (1, -1) for sb in (1, -1)])
+
+
+def test_a_mode_is_a_conjugate_pair_whatever_re_and_im():
+    """The issue's roots +-11.83 +- 7.5i: two modes, one growing and one decaying (the
+    decaying pair was dropped where |Re| > |Im|, the growing one shown twice); a real pair
+    +-s: its growing member; LAPACK's exact conjugates and a rounded real root alike."""
+    from gyro.qep import representatives
+
+    lam = np.array([11.83 + 7.5j, 11.83 - 7.5j, -11.83 + 7.5j, -11.83 - 7.5j])
+    assert sorted(representatives(lam, 2), key=lambda z: z.real) == [-11.83 + 7.5j, 11.83 + 7.5j]
+    lam = np.array([-3.0, 3.0, 2j, -2j])
+    assert sorted(representatives(lam, 2), key=abs) == [2j, 3.0]
+    lam = np.array([-3.0 - 1e-20j, 3.0 + 1e-20j, 5.0 - 1e-20j, -5.0 + 1e-20j])  # two divergent pairs
+    assert sorted(representatives(lam, 2).real) == [3.0, 5.0]
+
+
+@pytest.mark.parametrize("n", [10.0, 15.0])
+def test_sleeping_top_below_its_critical_spin_has_one_growing_mode(n):
+    """Below the critical spin C n < 2 sqrt(A m g l) (19.81 rad/s) the tilts flutter: roots
+    +-s +- i w, s = sqrt(4 A m g l - C^2 n^2) / (2 A), w = C n / (2 A); at n = 10, |Re| > |Im|
+    (4.27 > 2.5), at n = 15, |Re| < |Im| (3.23 < 3.75): one growing mode either way, and the
+    decaying one shown with it (1e-12: a 2x2 block's roots, module doc)."""
+    rc, out, err = run_cli("frequencies", TOP, "--set", f"n={n}", "--json")
+    assert rc == 0, err
+    doc = json.loads(out)
+    want = top_roots(n, **TOP_DEFAULTS)
+    s, w = abs(want[0].real), abs(want[0].imag)
+    got = np.array(doc["eigenvalues_re"]) + 1j * np.array(doc["frequencies"])
+    steady = doc["steady_roots"]
+    assert steady == [0] and got[0] == 0
+    assert np.allclose(sorted(got[1:], key=lambda z: z.real), [-s + 1j * w, s + 1j * w], rtol=1e-12, atol=0)
+    assert doc["stability"]["class"] == "unstable" and doc["stability"]["unstable_roots"] == 1
+    assert abs(doc["stability"]["growth_rate"] - s) <= 1e-12 * s
+
+
+def test_the_count_of_growing_modes_has_no_border_at_re_equal_im():
+    """Across |Re| = |Im| (n = sqrt(2 A m g l) / C = 14.0 rad/s) the count stays one; at
+    n = 0 the two tilts fall each on its own (two real pairs +-sqrt(m g l / A)): two."""
+    from gyro import ladder
+
+    model = load(TOP)
+    spins = [0.0, 5.0, 13.9, 14.1, 19.0]
+    P = np.array([model.vector({"n": n}) for n in spins])
+    c = ladder.classify(ladder.spectrum(model, P))
+    assert list(c.label) == ["unstable"] * 5 and list(c.unstable_roots) == [2, 1, 1, 1, 1]
+
+
+# --------------------------------------------------------------------------- boundaries and crashes
+
+ROTOR = str(ROOT / "examples" / "rigid_rotor.py")
+ISOTROPIC = ("--set", "Omega=0", "--set", "ky1=1e6", "--set", "ky2=1e6")
+
+
+def rotor_hand_roots(**over):
+    """The rotor's roots from its closed form (tests/test_anymodel.py), Im > 0, by |lambda|."""
+    from tests.test_anymodel import closed_form, exact_roots
+
+    model = load(ROTOR)
+    return exact_roots(*closed_form(model.parameters(over)))
+
+
+@pytest.mark.parametrize("method", ["default", "reference"])
+def test_damped_isotropic_rotor_at_rest_is_stable_not_boundary(method):
+    """Isotropic bearings at rest: two double roots (the x-z and y-z planes alike), every
+    Re <= -12.7 1/s. A double root well inside the left half-plane cannot change the
+    verdict: 'stable' (it was 'boundary: roots 1 and 2 merge'); no equilibrium coordinate:
+    the reference method answers (it raised IndexError). The roots are the closed form's,
+    within 1e-10 (tests/test_anymodel.py's argument: LAPACK on an 8x8 companion matrix)."""
+    rc, out, err = run_cli("frequencies", ROTOR, *ISOTROPIC, "--method", method, "--json")
+    assert rc == 0, err
+    doc = json.loads(out)
+    want = rotor_hand_roots(Omega=0.0, ky1=1e6, ky2=1e6)
+    got = np.array(doc["eigenvalues_re"]) + 1j * np.array(doc["frequencies"])
+    assert np.all(np.abs(got - want) <= 1e-10 * np.abs(want)), (got, want)
+    assert np.max(want.real) < -12 and doc["stability"]["class"] == "stable", doc["stability"]
+
+
+def test_isotropic_rotor_campbell_and_sweep_run_through_the_double_root():
+    rc, out, err = run_cli("campbell", ROTOR, "--set", "ky1=1e6", "--set", "ky2=1e6", "--spin-range", "0", "600",
+                           "--points", "3", "--json")
+    assert rc == 0 and err == "", err
+    doc = json.loads(out)
+    want = rotor_hand_roots(Omega=0.0, ky1=1e6, ky2=1e6)
+    assert np.allclose(doc["frequencies"][0], want.imag, rtol=1e-10, atol=0)
+    rc, out, err = run_cli("sweep", ROTOR, "--set", "ky1=1e6", "--set", "ky2=1e6", "--x", "Omega",
+                           "--x-range", "0", "600", "--points", "3", "--json")
+    assert rc == 0 and err == "", err
+
+
+def test_top_at_its_critical_spin_is_a_boundary_quoting_the_table():
+    """At n = 2 sqrt(A m g l) / C to the last digit the tilt roots collide on the axis (a
+    Jordan block): the 40-digit roots at the given doubles lie on it 1e-9 apart, and inputs
+    moved by 4 eps put them off it (by the square root, 1e-8): rounding decides, 'boundary'
+    (it raised IndexError in the reference rung), and the reason quotes the roots as the
+    table shows them (omega, not |lambda|)."""
+    n = 2 * np.sqrt(TOP_DEFAULTS["A"] * TOP_DEFAULTS["m"] * TOP_DEFAULTS["g"] * TOP_DEFAULTS["l"]) / TOP_DEFAULTS["C"]
+    rc, out, err = run_cli("frequencies", TOP, "--set", f"n={float(n)!r}")
+    assert rc == 0, err
+    last = out.strip().splitlines()[-1]
+    assert last.startswith("equilibrium: boundary") and "merge" in last, last
+    w = 0.01 * n / (2 * 0.02)
+    rows = [line.split() for line in out.splitlines() if line.strip()[:1] in "23"]
+    quoted = [r[1] for r in rows]
+    assert all(q in last for q in quoted) and all(abs(float(q) - w) < 1e-7 * w for q in quoted), (quoted, last)

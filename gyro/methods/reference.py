@@ -23,6 +23,8 @@ def _mp_equilibrium(mf, p, q0, idx, max_iter=60):
     beta = 5e-20 at (3.1), where its steps stay at the rounding of the others' residual),
     where the largest step is within tol of the largest coordinate and no longer shrinks."""
     q = [mpmath.mpf(v) for v in q0]
+    if not idx:  # no equilibrium coordinates (a rotor centred by its bearings): nothing to solve
+        return q
     tol = mpmath.mpf(10) ** (-mpmath.mp.dps + 5)
     last = None
     for _ in range(max_iter):

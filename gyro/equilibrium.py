@@ -117,7 +117,7 @@ def _solve(model: Model, P, q0, idx, is_angle, tol, max_iter):
     Newton came to rest without balancing the equations tried again from other starts
     (RESTARTS). Returns (qe, ok, report): qe as Newton left it (NaN where an iterate was not
     finite), ok where it is an equilibrium, report (residual_test's ratio, row and value,
-    and the point) of the first try of each set."""
+    the point, and whether other starts were tried) of the first try of each set."""
     qe, converged = _newton(model, P, q0.copy(), idx, is_angle, tol, max_iter)
     finite = np.all(np.isfinite(qe), axis=1)
     ratio, row, value = residual_test(model, P, qe, idx)
@@ -130,7 +130,7 @@ def _solve(model: Model, P, q0, idx, is_angle, tol, max_iter):
         with np.errstate(all="ignore"):
             r = function(model, "equilibrium_residual")(P[late], qe[late])[0].reshape(late.size, -1)[:, idx]
         ok[late] = np.max(np.abs(r), axis=1, initial=0.0) <= 1e-9 * (1 + np.max(np.abs(P[late]), axis=1))
-    report = {"ratio": ratio, "row": row, "value": value, "q": qe.copy()}
+    report = {"ratio": ratio, "row": row, "value": value, "q": qe.copy(), "restarted": converged & ~balanced}
     # Newton that could not start: it "converged" (a zero least-squares step along the null
     # direction of a singular K) where the equations do not hold; again from other starts
     stuck = np.flatnonzero(converged & finite & ~balanced & np.all(np.isfinite(P), axis=1))
@@ -293,14 +293,16 @@ def why_not(model: Model, report, k: int = 0) -> str:
     """One line on why set k of a batch has no equilibrium: the equation that does not hold
     at the last point tried, and by how much of the size of its terms."""
     names = model.meta["equilibrium_coordinates"]
-    ratio, row, value, q = (report[key][k] for key in ("ratio", "row", "value", "q"))
+    ratio, row, value, q, restarted = (report[key][k] for key in ("ratio", "row", "value", "q", "restarted"))
     if not np.all(np.isfinite(q)) or not names:
         return "Newton's method did not converge (an iterate was not finite)"
     at = ", ".join(f"{c} = {v:.6g}" for c, v in zip(names, q))
     if ratio <= RESIDUAL_TOL:
         return f"Newton's method did not converge (last at {at})"
-    return (f"the equation of {names[row]} keeps a residual of {value:.3g} at {at}, {ratio:.2g} of the "
-            f"size of its terms (an equilibrium leaves below {RESIDUAL_TOL:g}), and at every other start tried")
+    where = ("Newton's method came to rest where" if restarted else "Newton's method did not converge:")
+    return (f"{where} the equation of {names[row]} keeps a residual of {value:.3g} at {at}, {ratio:.2g} of the "
+            f"size of its terms (an equilibrium leaves below {RESIDUAL_TOL:g})"
+            + (", and so it did from every other start tried" if restarted else ""))
 
 
 def operators(model: Model, P: np.ndarray, qe: np.ndarray):

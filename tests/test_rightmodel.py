@@ -216,3 +216,21 @@ def test_top_at_its_critical_spin_is_a_boundary_quoting_the_table():
     rows = [line.split() for line in out.splitlines() if line.strip()[:1] in "23"]
     quoted = [r[1] for r in rows]
     assert all(q in last for q in quoted) and all(abs(float(q) - w) < 1e-7 * w for q in quoted), (quoted, last)
+
+
+def test_a_point_newton_circles_is_no_equilibrium_unless_it_balances():
+    """The torsion gyrocompass at g = 0 with Kgamma = 1e-9 and K0 = 1e-6 (a set of the fuzz
+    test): Newton circles the nearly free azimuth for its 100 steps and stops where the
+    equations miss by 5 % of their terms (the gamma2 equation by 2.2e-5 N m at a stiffness
+    of 3.2e-5 N m/rad: the angle off by the order of a radian). It was accepted by an
+    absolute residual of 1e-9 (1 + max |p|) = 2.4e-4 (Kp = 243360); now refused in one line."""
+    from gyro import load as load_builtin
+    from gyro.equilibrium import equilibria
+
+    model = load_builtin("torsion_gyrocompass")
+    args = ("--set", "Kgamma=1e-09", "--set", "g=0.0", "--set", "K0=1e-06")
+    qe, ok = equilibria(model, model.vector(model.parameters({"Kgamma": 1e-9, "g": 0.0, "K0": 1e-6}))[None])
+    assert not ok[0] and np.isnan(qe).all()
+    rc, out, err = run_cli("frequencies", "torsion_gyrocompass", *args)
+    assert rc == 1 and out == "" and len(err.strip().splitlines()) == 1
+    assert "did not converge: the equation of" in err and "keeps a residual" in err, err

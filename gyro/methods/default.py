@@ -100,20 +100,7 @@ def solve(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
             continue
         route[k] = "reference"
         freq[k], growth[k], est[k] = ref.frequencies[0], ref.growth[0], ref.error_estimate[0]
-        # the reference takes the doubles as exact; this method answers for the decimal
-        # inputs, whose rounding moves a cluster of roots (a collision) by its square root
-        est[k] += qep.cluster_rounding(P[k], growth[k] + 1j * freq[k], lambda Pp: _reference_roots(model, Pp))
         qe[k] = ref.equilibrium[0]
     f, g, e = qep.sort_spectrum(freq, growth, est)
     return Spectrum("default", f, g, e, qe, route)
 
-
-def _reference_roots(model: Model, p) -> np.ndarray:
-    """The roots of one set by the reference method (NaN where it cannot answer)."""
-    from gyro.methods import reference
-
-    try:
-        ref = reference.solve(model, p[None])
-    except (EquilibriumError, ArithmeticError, ValueError, np.linalg.LinAlgError):
-        return np.full(1, np.nan + 0j)
-    return ref.growth[0] + 1j * ref.frequencies[0]

@@ -10,7 +10,12 @@ a steadily turning coordinate, which no unknown enters, must hold to the same bo
 drive balancing friction at these parameters) or the set has no reference motion; inputs
 whose operator is beyond double precision never reach LAPACK. With a compiler the iteration
 runs in the generated C set by set (templates/equilibrium.c.j2), which answers the sets it
-converges on and hands every other back to the NumPy iteration (_newton_numpy)."""
+converges on and hands every other back to the NumPy iteration (_newton_numpy). Every
+answer, of either, is then held to the equations (residual_test: each residual below
+RESIDUAL_TOL of the size of its terms); a set that Newton left off balance after
+converging (a singular K at the start: the least-squares step is zero along its null
+direction) is tried again from moved starts (RESTARTS), and a set balanced by none is
+refused (why_not says which equation keeps which residual)."""
 from __future__ import annotations
 
 import numpy as np

@@ -234,3 +234,22 @@ def test_a_point_newton_circles_is_no_equilibrium_unless_it_balances():
     rc, out, err = run_cli("frequencies", "torsion_gyrocompass", *args)
     assert rc == 1 and out == "" and len(err.strip().splitlines()) == 1
     assert "did not converge: the equation of" in err and "keeps a residual" in err, err
+
+
+def test_merged_disks_inside_the_left_half_plane_decide_the_verdict():
+    """verdict.spectrum without `conservative`: two rigorous disks that overlap wholly in
+    Re z < 0 hold both roots there: stable (was boundary); one that meets the axis stays a
+    boundary; with `conservative` an overlap on the axis stays a possible Krein collision."""
+    from gyro.results import verdict
+
+    lam = np.array([[-5 + 1j, -5 + 1j], [-1e-4 + 1j, -1e-4 + 1j]])
+    v = verdict.spectrum(lam, np.full(lam.shape, 1e-3), conservative=False)
+    assert list(v.label) == ["stable", "boundary"]
+    v = verdict.spectrum(np.array([[1j, 1j]]), np.full((1, 2), 1e-3), conservative=True)
+    assert v.label[0] == "boundary"
+    from gyro.results.verdict import cluster_meets_axis
+
+    # a double root at Re -5 known to 1e-10 relative: R = 2 |lambda| 1e-5, far from the axis
+    assert not cluster_meets_axis(np.array([[-5 + 1j, -5 + 1j]]), np.full((1, 2), 1e-9), np.full((1, 2), 1e-10)).any()
+    # at Re -1e-6 it may reach the axis
+    assert cluster_meets_axis(np.array([[-1e-6 + 1j, -1e-6 + 1j]]), np.full((1, 2), 1e-9), np.full((1, 2), 1e-10)).all()

@@ -8,8 +8,9 @@ The labels:
   bounds);
 - ``marginal``: a neutral direction found exactly (an exact zero root: a free coordinate);
 - ``unstable``: a root grows by more than its error bound;
-- ``boundary``: rounding could change the verdict (roots merged within their error bounds,
-  a root not resolved from zero, a condition's margin within its rounding bound of zero);
+- ``boundary``: rounding could change the verdict (roots merged within their error bounds
+  in a cluster that may reach the imaginary axis: cluster_meets_axis; a root not resolved
+  from zero; a condition's margin within its rounding bound of zero);
   never counted as stable or as stabilised;
 - ``unknown``: no bound (a method that lost a root, or computes no growth rates);
 - ``failed``: the set could not be computed.
@@ -132,7 +133,7 @@ def spectrum(lam: np.ndarray, radius: np.ndarray, conservative: bool = True,
 
     - unstable: some disk lies in Re z > 0 (a root grows whatever rounding did); when
       `conservative`, also a disk wholly in Re z < 0 (its mirror root grows);
-    - boundary: otherwise, two disks overlap, or (when `conservative`) a root's mirror disk
+    - boundary: otherwise, when `conservative`, two disks overlap or a root's mirror disk
       meets another root's disk (the exact roots may coincide there: a Krein collision, a
       Jordan block, a zero root with its mirror image);
     - stable: otherwise, when `conservative` (a Hamiltonian spectrum: an isolated disk that
@@ -170,7 +171,9 @@ def spectrum(lam: np.ndarray, radius: np.ndarray, conservative: bool = True,
         d = np.abs(-np.conj(lam)[:, :, None] - lam[:, None, :])
         overlap |= (d <= r[:, :, None] + r[:, None, :]) & ~np.eye(m, dtype=bool)
     at_zero = np.abs(lam) <= r
-    merged = np.any(overlap, axis=(1, 2))
+    # without `conservative` the disks decide alone: a union of disks in Re z < 0 holds only
+    # roots there (the disks are rigorous, merged or not), one that meets the axis is on_axis
+    merged = np.any(overlap, axis=(1, 2)) if conservative else np.zeros(n, bool)
     on_axis = np.any(np.abs(lam.real) <= r, axis=1)
     label = np.full(n, "stable", dtype=object)
     reason = np.full(n, None, dtype=object)

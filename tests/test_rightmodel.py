@@ -253,3 +253,23 @@ def test_merged_disks_inside_the_left_half_plane_decide_the_verdict():
     assert not cluster_meets_axis(np.array([[-5 + 1j, -5 + 1j]]), np.full((1, 2), 1e-9), np.full((1, 2), 1e-10)).any()
     # at Re -1e-6 it may reach the axis
     assert cluster_meets_axis(np.array([[-1e-6 + 1j, -1e-6 + 1j]]), np.full((1, 2), 1e-9), np.full((1, 2), 1e-10)).all()
+
+
+def test_stability_map_of_the_top_is_maievski_with_one_growing_mode(tmp_path):
+    """Over the spin n and the offset l: stable where C^2 n^2 > 4 A m g l (Maievski), one
+    growing mode below it on both sides of |Re| = |Im| (the map drew 'two or more' where
+    |Re| > |Im|, that is C^2 n^2 < 2 A m g l). The grid's points lie at least 1 % (in C^2 n^2 /
+    4 A m g l) from the critical spin: the tilt roots are then 0.1 |lambda| apart, or off
+    the axis by as much, resolved far beyond their bounds."""
+    rc, out, err = run_cli("stability-map", TOP, "--x", "n", "--x-range", "1", "30", "--y", "l", "--y-range",
+                           "0.02", "0.08", "--points", "6", "--out", str(tmp_path / "m.png"), "--json")
+    assert rc == 0, err
+    doc = json.loads(out)
+    A, C, m, g = (TOP_DEFAULTS[k] for k in ("A", "C", "m", "g"))
+    n, l = np.meshgrid(doc["x"]["values"], doc["y"]["values"])
+    margin = C**2 * n**2 / (4 * A * m * g * l) - 1
+    assert np.min(np.abs(margin)) > 0.01
+    want = np.where(margin > 0, "stable", "unstable")
+    assert np.array_equal(np.array(doc["values"]), want)
+    assert np.array_equal(np.array(doc["unstable_roots"]), (margin < 0).astype(int))
+    assert np.any(C**2 * n**2 < 2 * A * m * g * l)  # the flutter with |Re| > |Im| is on the grid

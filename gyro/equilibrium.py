@@ -5,7 +5,8 @@ the operator's stiffness K as the Jacobian, vectorised over the batch.
 Steps on angles are damped to MAX_ANGLE_STEP so that each set stays on the branch it
 starts from; a set whose K is singular takes a least-squares step (g = 0 leaves the azimuth
 free); a set that has not converged after MAX_ITER steps is accepted when its residual is
-below 1e-9 (1 + max |p|), as an exact but ill-conditioned equilibrium is; the equation of
+below 1e-9 (1 + max |p|) and passes the residual test below, as an exact but
+ill-conditioned equilibrium does; the equation of
 a steadily turning coordinate, which no unknown enters, must hold to the same bound (a
 drive balancing friction at these parameters) or the set has no reference motion; inputs
 whose operator is beyond double precision never reach LAPACK. With a compiler the iteration
@@ -102,6 +103,10 @@ def _equilibria(model: Model, P, tol=TOL, max_iter=MAX_ITER):
         with np.errstate(all="ignore"):
             qe = function(model, "equilibrium_approx")(P)[0].reshape(n, -1)
         qe = np.where(np.isfinite(qe), qe, 0.0)  # (2.2) divides by g: at g = 0 start from zero
+        # an angle beyond 2^26 rad is known to no better than 2^-26 = 1.5e-8 rad (the spacing
+        # of doubles there), more than an equilibrium's residual allows (RESIDUAL_TOL): (2.2)
+        # at the pole gives 1.6e16; such a start is taken within one turn
+        qe = np.where(is_angle & (np.abs(qe) > 2.0**26), wrap(qe), qe)
     else:
         qe = np.zeros((n, len(names)))
     qe, ok, report = _solve(model, P, qe, idx, is_angle, tol, max_iter)
@@ -177,7 +182,7 @@ def _moved_start(q0, is_angle, shift):
 def residual_test(model: Model, P, qe, idx):
     """Per set: (max_i |r_i| / T_i, the row i of that maximum, r_i), r the residual of the
     equilibrium equations at qe and T_i the size of the terms row i combines, measured as
-    sum_j |p_j dr_i/dp_j| + sum_j |K_ij| |q_j|: each term of r_i that carries p_j (or q_j)
+    sum_j |p_j dr_i/dp_j| + sum_j |K_ij| |q_j| (angles wrapped): each term of r_i that carries p_j (or q_j)
     to the power d contributes d times itself to p_j dr_i/dp_j, so T_i is at least the
     largest term unless terms of the same degree in every parameter and every coordinate
     cancel. p dr/dp by a forward difference with the relative step 2^-20 (its rounding
@@ -189,7 +194,9 @@ def residual_test(model: Model, P, qe, idx):
         return np.zeros(n), np.zeros(n, int), np.zeros(n)
     with np.errstate(all="ignore"):
         r, K = _system(model, idx)(P, qe)
-        T = np.einsum("bij,bj->bi", np.abs(K), np.abs(qe))
+        # an angle's size within one turn: an iterate can leave Newton unwrapped
+        size = np.abs(np.where(_layout(model)[2], wrap(qe), qe))
+        T = np.einsum("bij,bj->bi", np.abs(K), size)
         # the coordinates' part alone passes most sets (a regular K: r = K dq, dq below TOL
         # |q|); the parameters' part, n_p more evaluations, only where it does not
         late = np.flatnonzero(~np.all(np.abs(r) <= RESIDUAL_TOL * T, axis=1))
@@ -292,6 +299,16 @@ def equilibrium(model: Model, params) -> np.ndarray:
     if not ok[0]:
         raise EquilibriumError(why_not(model, report))
     return qe[0]
+
+
+def unbalanced(model: Model, params) -> str | None:
+    """For one parameter set: why_not's line where the set has no equilibrium because the
+    equations keep a residual at a finite point (not for inputs beyond double precision,
+    whose iterates are not finite: a numerical failure), else None."""
+    qe, ok, report = _equilibria(model, np.asarray(params, dtype=float)[None, :])
+    if ok[0] or not np.all(np.isfinite(report["q"][0])) or not report["ratio"][0] > RESIDUAL_TOL:
+        return None
+    return why_not(model, report)
 
 
 def why_not(model: Model, report, k: int = 0) -> str:

@@ -39,9 +39,11 @@ def run(args) -> int:
     spec = ladder.spectrum(model, model.vector(values), args.method, modes=args.modes)
     if not (np.all(np.isfinite(spec.frequencies[0])) and np.all(np.isfinite(spec.growth[0]))):
         if spec.equilibrium is not None and not np.all(np.isfinite(spec.equilibrium[0])):
-            from gyro.equilibrium import equilibrium
+            from gyro.equilibrium import EquilibriumError, unbalanced
 
-            equilibrium(model, model.vector(values))  # no equilibrium: one line naming the residual
+            reason = unbalanced(model, model.vector(values))
+            if reason:  # no equilibrium: one line naming the residual
+                raise EquilibriumError(reason)
         raise FloatingPointError("a frequency is not finite")  # no verdict: exit 1, text and JSON alike
     sens = None
     if getattr(args, "sensitivities", False):

@@ -273,3 +273,24 @@ def test_stability_map_of_the_top_is_maievski_with_one_growing_mode(tmp_path):
     assert np.array_equal(np.array(doc["values"]), want)
     assert np.array_equal(np.array(doc["unstable_roots"]), (margin < 0).astype(int))
     assert np.any(C**2 * n**2 < 2 * A * m * g * l)  # the flutter with |Re| > |Im| is on the grid
+
+
+@pytest.mark.parametrize("method", ["polyroots", "companion", "default", "reference"])
+def test_no_method_raises_at_a_double_root(method):
+    """Every rung at the isotropic rotor's double roots (no equilibrium coordinates) and at
+    the top's collision: an answer, exit 0, each root of the rotor within ten times its own
+    bound of the closed form (a first-order bound, as tests/test_anymodel.py allows) or a
+    verdict that claims nothing ('unknown'); the top's collision a boundary or no verdict,
+    never 'stable' or 'unstable'."""
+    rc, out, err = run_cli("frequencies", ROTOR, *ISOTROPIC, "--method", method, "--json")
+    assert rc == 0 and "Traceback" not in err, err
+    doc = json.loads(out)
+    want = rotor_hand_roots(Omega=0.0, ky1=1e6, ky2=1e6)
+    got = np.array(doc["eigenvalues_re"]) + 1j * np.array(doc["frequencies"])
+    bound = np.array([np.inf if e is None else e for e in doc["error_estimate"]])
+    assert doc["stability"]["class"] == "unknown" or np.all(
+        np.abs(got - want) <= 10 * np.maximum(bound, 1e-15) * np.abs(want)), (got, want, bound)
+    n = 2 * np.sqrt(TOP_DEFAULTS["A"] * TOP_DEFAULTS["m"] * TOP_DEFAULTS["g"] * TOP_DEFAULTS["l"]) / TOP_DEFAULTS["C"]
+    rc, out, err = run_cli("frequencies", TOP, "--set", f"n={float(n)!r}", "--method", method, "--json")
+    assert rc == 0 and "Traceback" not in err, err
+    assert json.loads(out)["stability"]["class"] in ("boundary", "unknown")

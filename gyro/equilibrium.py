@@ -89,12 +89,12 @@ def _groups(model: Model) -> np.ndarray:
 def equilibria(model: Model, P: np.ndarray, tol: float = TOL, max_iter: int = MAX_ITER):
     """Relative equilibria of a batch P (sets, parameters). Returns (qe, ok): qe (sets,
     equilibrium coordinates), NaN where ok is False."""
-    qe, ok, _ = _equilibria(model, P, tol, max_iter)
+    qe, ok, _ = equilibria_reported(model, P, tol, max_iter)
     return qe, ok
 
 
-def _equilibria(model: Model, P, tol=TOL, max_iter=MAX_ITER):
-    """equilibria, and _solve's report of each set."""
+def equilibria_reported(model: Model, P, tol=TOL, max_iter=MAX_ITER):
+    """equilibria, and _solve's report of each set (why_not reads it)."""
     require_time_free(model)
     P = np.atleast_2d(np.asarray(P, dtype=float))
     names, idx, is_angle = _layout(model)
@@ -295,7 +295,7 @@ def _system(model: Model, idx):
 def equilibrium(model: Model, params) -> np.ndarray:
     """The relative equilibrium of one parameter set (metadata 'equilibrium_coordinates'),
     or EquilibriumError."""
-    qe, ok, report = _equilibria(model, np.asarray(params, dtype=float)[None, :])
+    qe, ok, report = equilibria_reported(model, np.asarray(params, dtype=float)[None, :])
     if not ok[0]:
         raise EquilibriumError(why_not(model, report))
     return qe[0]
@@ -305,7 +305,7 @@ def unbalanced(model: Model, params) -> str | None:
     """For one parameter set: why_not's line where the set has no equilibrium because the
     equations keep a residual at a finite point (not for inputs beyond double precision,
     whose iterates are not finite: a numerical failure), else None."""
-    qe, ok, report = _equilibria(model, np.asarray(params, dtype=float)[None, :])
+    qe, ok, report = equilibria_reported(model, np.asarray(params, dtype=float)[None, :])
     if ok[0] or not np.all(np.isfinite(report["q"][0])) or not report["ratio"][0] > RESIDUAL_TOL:
         return None
     return why_not(model, report)

@@ -103,4 +103,3 @@ def solve(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
         qe[k] = ref.equilibrium[0]
     f, g, e = qep.sort_spectrum(freq, growth, est)
     return Spectrum("default", f, g, e, qe, route)
-

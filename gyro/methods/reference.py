@@ -7,7 +7,7 @@ import mpmath
 import numpy as np
 
 from gyro import qep
-from gyro.equilibrium import EquilibriumError, _equilibria, why_not
+from gyro.equilibrium import EquilibriumError, equilibria_reported, why_not
 from gyro.models import Model
 from gyro.results import Spectrum
 
@@ -92,7 +92,7 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None, dps: int = DPS)
     reduced = model.meta["reduced"]
     idx = [reduced.index(c) for c in model.meta["equilibrium_coordinates"]]
     N = P.shape[0]
-    qe_d, ok, report = _equilibria(model, P)
+    qe_d, ok, report = equilibria_reported(model, P)
     out = None
     with mpmath.workdps(dps):
         for k in range(N):

@@ -25,7 +25,7 @@ TIERS = {
               "test_precession_base"),
     "methods": ("test_ladder", "test_companion_bound", "test_sensitivity", "test_hierarchy", "test_torsion_motion",
                 "test_scene_figures", "test_harmonic", "test_block_starts", "test_anymodel", "test_roots",
-                "test_equilibrium_c"),
+                "test_equilibrium_c", "test_rightmodel"),
     "properties": ("test_properties",),
     "cli": ("test_cli", "test_gimbal_simulate", "test_readme", "test_sweep", "test_wheel", "test_ghc_cli", "test_fuzz", "test_robustness",
             "test_tolerance", "test_executor", "test_motion_generic", "test_precession_cli", "test_forced",

@@ -67,9 +67,19 @@ def tame(X) -> np.ndarray:
 
 
 def _layout(model: Model):
+    """(equilibrium coordinates, the rows of the Newton system, which are angles). The rows
+    are the equilibrium coordinates' places among the reduced ones; a model with
+    multipliers has all coordinates as unknowns and its own square system (the reduced
+    residual and the constraints: equilibrium_system), rows 0..n-1."""
     reduced = model.meta["reduced"]
     names = model.meta["equilibrium_coordinates"]
-    idx = np.array([reduced.index(c) for c in names], dtype=int)
+    if model.meta.get("constraints", {}).get("multipliers"):
+        if "equilibrium_system" not in model.meta["functions"]:
+            raise ParameterError(f"{model.name}: a model with multipliers emitted without equilibrium_system "
+                                 "(derive it again with this version)")
+        idx = np.arange(len(names), dtype=int)
+    else:
+        idx = np.array([reduced.index(c) for c in names], dtype=int)
     units = model.meta.get("coordinate_units", {})
     return names, idx, np.array([units.get(c) == "rad" for c in names], dtype=bool)
 
@@ -109,7 +119,22 @@ def equilibria_reported(model: Model, P, tol=TOL, max_iter=MAX_ITER):
         qe = np.where(is_angle & (np.abs(qe) > 2.0**26), wrap(qe), qe)
     else:
         qe = np.zeros((n, len(names)))
+    if model.meta.get("constraints", {}).get("multipliers"):
+        qe = on_constraints(model, P, qe, is_angle)
+    starts = qe.copy()
     qe, ok, report = _solve(model, P, qe, idx, is_angle, tol, max_iter)
+    report["degenerate"] = np.zeros(n, bool)
+    if model.meta.get("constraints", {}).get("multipliers") and not ok.all():
+        for k in np.flatnonzero(~ok & np.all(np.isfinite(P), axis=1)):
+            q = augmented_statics(model, P[k], starts[k])
+            if q is not None:
+                qe[k], ok[k] = q, True
+                report["q"][k] = q
+    if model.meta.get("constraints", {}).get("multipliers") and ok.any():
+        k = np.flatnonzero(ok)
+        bad = degenerate_independent(model, P[k], qe[k])
+        ok[k[bad]] = False
+        report["degenerate"][k[bad]] = True
     resid = function(model, "equilibrium_residual")
     steady = [model.meta["reduced"].index(c) for c in model.meta.get("steady", {})]
     if steady and ok.any():  # a steady coordinate's row: no unknown enters it, it must hold itself
@@ -120,6 +145,110 @@ def equilibria_reported(model: Model, P, tol=TOL, max_iter=MAX_ITER):
     qe = np.where(is_angle, wrap(qe), qe)
     qe[~ok] = np.nan
     return qe, ok, report
+
+
+# starts of the dependent coordinates of a model with multipliers, in their units (angles
+# in rad): the first from which the constraints are solved is taken
+DEPENDENT_STARTS = (1.0, 0.5, -1.0, 2.0, -0.5, 0.1)
+
+
+def on_constraints(model: Model, P, q0, is_angle, max_iter: int = 50):
+    """The starts of a model with multipliers moved onto its constraints: the independent
+    coordinates as they are, the dependent ones solved from phi(q) = 0 by Newton's method on
+    the emitted constraints and their Jacobian (quantity `constraints`), from each of
+    DEPENDENT_STARTS in turn (a start of zero puts a pendulum in Cartesian coordinates at its
+    pivot, where the constraint's Jacobian vanishes). The first start whose iteration meets
+    the constraints to 1e-12 of the coordinates' size answers a set; a set none does keeps
+    its start (the equilibrium's own Newton then tries, and its residual test decides)."""
+    meta = model.meta
+    names = list(meta["equilibrium_coordinates"])
+    dep = [names.index(c) for c in meta["constraints"]["dependent"]]
+    fn = function(model, "constraints")
+    q0 = np.array(q0, float)
+    todo = np.arange(P.shape[0])
+    for start in DEPENDENT_STARTS:
+        if todo.size == 0:
+            break
+        q = q0[todo].copy()
+        q[:, dep] = start
+        for _ in range(max_iter):
+            with np.errstate(all="ignore"):
+                phi, J = fn(P[todo], q)
+                phi = np.asarray(phi).reshape(todo.size, -1)
+                J = np.asarray(J).reshape(todo.size, len(dep), -1)[:, :, dep]
+                step = np.array([_solve_or_lstsq(j, f) if np.all(np.isfinite(j)) and np.all(np.isfinite(f))
+                                 else np.full(len(dep), np.nan) for j, f in zip(J, phi)])
+            step = np.clip(step, -1.0, 1.0) if is_angle[dep].all() else step
+            q[:, dep] -= step
+            if not np.all(np.isfinite(q)) or np.max(np.abs(step)) <= 1e-15 * max(1.0, np.max(np.abs(q))):
+                break
+        with np.errstate(all="ignore"):
+            phi = np.asarray(fn(P[todo], q)[0]).reshape(todo.size, -1)
+        met = np.all(np.isfinite(q), axis=1) & (np.max(np.abs(phi), axis=1) <= 1e-12 * np.maximum(
+            1.0, np.max(np.abs(q), axis=1)))
+        q0[todo[met]] = q[met]
+        todo = todo[~met]
+    return q0
+
+
+def augmented_statics(model: Model, p, q0):
+    """For one set of a model with multipliers whose Newton in the independent coordinates
+    failed: the equilibrium from the statics of all coordinates and the multipliers,
+    f(q, 0) = Phi_q(q)' lambda and phi(q) = 0 (the first n rows of the emitted forcing at
+    rest, the emitted constraints), by scipy's hybrid method from q0 with lambda from least
+    squares. It needs no choice of independent coordinates, so it finds an equilibrium
+    where the chosen ones do not parametrise the motion (degenerate_independent then says
+    so). Returns q, or None where it finds none to 1e-10 of the forces' size."""
+    from scipy.optimize import root
+
+    n = len(model.meta["coordinates"])
+    forcing, cons = function(model, "forcing"), function(model, "constraints")
+    specs = model.meta["functions"]["forcing"]["inputs"][3:]
+    extra = [np.zeros((1, len(sp["symbols"]))) for sp in specs]
+    P = np.asarray(p, float)[None, :]
+
+    def f0(q):
+        return np.asarray(forcing(P, q[None, :], np.zeros((1, n)), *extra)[0]).reshape(-1)[:n]
+
+    def F(x):
+        q, lam = x[:n], x[n:]
+        phi, J = cons(P, q[None, :])
+        J = np.asarray(J).reshape(-1, n)
+        return np.concatenate([f0(q) - J.T @ lam, np.asarray(phi).reshape(-1)])
+
+    is_angle = _layout(model)[2]
+    with np.errstate(all="ignore"):
+        scale = max(float(np.max(np.abs(f0(q0)))), 1.0)
+        for shift in (0.0,) + RESTARTS:  # q0 first, then moved as the Newton's restarts are
+            q1 = _moved_start(q0[None, :], is_angle, shift)[0] if shift else q0
+            J0 = np.asarray(cons(P, q1[None, :])[1]).reshape(-1, n)
+            lam0 = (np.linalg.lstsq(J0.T, f0(q1), rcond=None)[0] if np.all(np.isfinite(J0))
+                    else np.zeros(J0.shape[0]))
+            sol = root(F, np.concatenate([q1, lam0]), method="hybr")
+            if sol.success and np.all(np.isfinite(sol.x)) and np.max(np.abs(F(sol.x))) <= 1e-10 * scale:
+                return sol.x[:n]
+    return None
+
+
+def degenerate_independent(model: Model, P, qe) -> np.ndarray:
+    """Per set of a model with multipliers: True where its constraints cannot be solved for
+    the dependent coordinates at the equilibrium (the smallest singular value of their
+    block of the constraints' Jacobian below 1e-8 of the whole Jacobian's largest: C then
+    carries entries beyond 1e8 and the reduced operator, C' Mq C, loses every digit): the
+    independent coordinates `reduced` names do not parametrise the motion there (a pendulum
+    in Cartesian coordinates hanging along q1 with q1 independent), and the operator in them
+    would be infinite."""
+    names = list(model.meta["equilibrium_coordinates"])
+    dep = [names.index(c) for c in model.meta["constraints"]["dependent"]]
+    with np.errstate(all="ignore"):
+        J = np.asarray(function(model, "constraints")(P, qe)[1]).reshape(P.shape[0], len(dep), -1)
+        out = np.ones(P.shape[0], bool)
+        fin = np.all(np.isfinite(J), axis=(1, 2))
+        if fin.any():
+            small = np.linalg.svd(J[fin][:, :, dep], compute_uv=False)[:, -1]
+            whole = np.linalg.svd(J[fin], compute_uv=False)[:, 0]
+            out[fin] = ~(small > 1e-8 * whole)
+    return out
 
 
 def _solve(model: Model, P, q0, idx, is_angle, tol, max_iter):
@@ -138,7 +267,7 @@ def _solve(model: Model, P, q0, idx, is_angle, tol, max_iter):
     late = np.flatnonzero(~converged & finite & balanced)
     if late.size:
         with np.errstate(all="ignore"):
-            r = function(model, "equilibrium_residual")(P[late], qe[late])[0].reshape(late.size, -1)[:, idx]
+            r = _rows(model, idx)(P[late], qe[late])
         ok[late] = np.max(np.abs(r), axis=1, initial=0.0) <= 1e-9 * (1 + np.max(np.abs(P[late]), axis=1))
     report = {"ratio": ratio, "row": row, "value": value, "q": qe.copy(), "restarted": converged & ~balanced}
     # Newton that could not start: it "converged" (a zero least-squares step along the null
@@ -201,10 +330,10 @@ def residual_test(model: Model, P, qe, idx):
         # |q|); the parameters' part, n_p more evaluations, only where it does not
         late = np.flatnonzero(~np.all(np.abs(r) <= RESIDUAL_TOL * T, axis=1))
         if late.size:
-            resid, h, m = function(model, "equilibrium_residual"), 2.0**-20, late.size
+            rows, h, m = _rows(model, idx), 2.0**-20, late.size
             Pl = P[late]
             Pall = np.concatenate([Pl * np.where(np.arange(npar) == j, 1 + h, 1.0) for j in range(npar)])
-            rall = resid(Pall, np.tile(qe[late], (npar, 1)))[0].reshape(npar, m, -1)[:, :, idx]
+            rall = rows(Pall, np.tile(qe[late], (npar, 1))).reshape(npar, m, -1)
             T[late] += np.sum(np.abs(rall - r[late]), axis=0) / h
         ratio = np.where(np.abs(r) == 0, 0.0, np.abs(r) / T)
     ratio = np.where(np.isfinite(ratio), ratio, np.inf)
@@ -278,6 +407,15 @@ def _solve_or_lstsq(K, r):
         return np.linalg.lstsq(K, r, rcond=None)[0]
 
 
+def _rows(model: Model, idx):
+    """(P, qe) -> the residual rows of the Newton system, (sets, len(idx))."""
+    if model.meta.get("constraints", {}).get("multipliers"):
+        system = _system(model, idx)
+        return lambda P, qe: system(P, qe)[0]
+    resid = function(model, "equilibrium_residual")
+    return lambda P, qe: resid(P, qe)[0].reshape(P.shape[0], -1)[:, idx]
+
+
 def _system(model: Model, idx):
     """(P, qe) -> (r, K) of the Newton step over the equilibrium coordinates: the model's
     equilibrium_system; for a model generated before it existed, the residual's rows idx and
@@ -316,13 +454,22 @@ def why_not(model: Model, report, k: int = 0) -> str:
     at the last point tried, and by how much of the size of its terms."""
     names = model.meta["equilibrium_coordinates"]
     ratio, row, value, q, restarted = (report[key][k] for key in ("ratio", "row", "value", "q", "restarted"))
+    if report.get("degenerate") is not None and report["degenerate"][k]:
+        c = model.meta["constraints"]
+        at = ", ".join(f"{n} = {v:.6g}" for n, v in zip(names, q))
+        return (f"none in the independent coordinates {', '.join(c['independent'])}: at the equilibrium of all "
+                f"coordinates ({at}) the constraints cannot be solved for the dependent ones "
+                f"{', '.join(c['dependent'])} (their Jacobian is singular there), so {', '.join(c['independent'])} "
+                "do not parametrise the motion about it; name others in the model's `reduced`")
+    rows = (list(model.meta["reduced"]) + [f"constraint {j + 1}" for j in range(len(
+        model.meta["constraints"]["holonomic"]))]) if model.meta.get("constraints", {}).get("multipliers") else names
     if not np.all(np.isfinite(q)) or not names:
         return "Newton's method did not converge (an iterate was not finite)"
     at = ", ".join(f"{c} = {v:.6g}" for c, v in zip(names, q))
     if ratio <= RESIDUAL_TOL:
         return f"Newton's method did not converge (last at {at})"
     where = ("Newton's method came to rest where" if restarted else "Newton's method did not converge:")
-    return (f"{where} the equation of {names[row]} keeps a residual of {value:.3g} at {at}, {ratio:.2g} of the "
+    return (f"{where} the equation of {rows[row]} keeps a residual of {value:.3g} at {at}, {ratio:.2g} of the "
             f"size of its terms (an equilibrium leaves below {RESIDUAL_TOL:g})"
             + (", and so it did from every other start tried" if restarted else ""))
 

@@ -91,6 +91,15 @@ def tg_functions():
     return derived(MODEL)[2]
 
 
+NOTICES = ("gyro: deriving the model file", "gyro: compiling the generated C")
+
+
+def error_lines(err: str) -> list[str]:
+    """stderr's lines but a model's first-use notices (deriving a model file, compiling its
+    C), which a cold cache prints before the command's own line."""
+    return [ln for ln in err.strip().splitlines() if not ln.startswith(NOTICES)]
+
+
 def run_cli(*args):
     """`gyro ARGS` in this process: (exit code, stdout, stderr); argparse's usage errors too."""
     import io

@@ -9,6 +9,7 @@ nonholonomic constraint is refused before any constraint is solved."""
 from __future__ import annotations
 
 import io
+import json
 import random
 
 import mpmath
@@ -125,3 +126,76 @@ def test_nonholonomic_refused_before_any_constraint_is_solved(monkeypatch):
     with pytest.raises(Unsupported, match="nonholonomic"):
         pipeline.derive(model, pipeline.Steps(out=io.StringIO()))
     assert not called
+
+
+# --------------------------------------------------------------------------- the runtime on them
+
+
+def test_frequencies_of_a_pendulum_held_by_a_multiplier(tmp_path):
+    """gyro frequencies on the Cartesian pendulum (q2 independent): the equilibrium on the
+    circle from the constraints (q = (L, 0)) and omega = sqrt(g/L) to rounding; a sweep over
+    L follows sqrt(g/L); a motion from it stays on the circle to the integrator's tolerance
+    and swings at that frequency."""
+    from tests.conftest import ROOT, run_cli
+
+    path = str(ROOT / "tests" / "models" / "nonminimal_pendulum.py")
+    rc, out, err = run_cli("frequencies", path, "--json")
+    assert rc == 0, err
+    doc = json.loads(out)
+    assert doc["equilibrium"] == {"q1": 0.5, "q2": 0.0}
+    assert abs(doc["frequencies"][0] - np.sqrt(9.8 / 0.5)) < 1e-14 * np.sqrt(9.8 / 0.5)
+    assert doc["stability"]["class"] == "stable"
+    rc, out, err = run_cli("sweep", path, "--x", "L", "--x-range", "0.2", "2", "--points", "4", "--json")
+    assert rc == 0, err
+    doc = json.loads(out)
+    got = np.array(doc["frequencies"])[:, 0]
+    assert np.allclose(got, np.sqrt(9.8 / np.array(doc["x"]["values"])), rtol=1e-13, atol=0)
+    rc, out, err = run_cli("simulate", path, "--t-end", "1.41923", "--points", "3", "--perturb", "q2_d=0.01",
+                           "--json")
+    assert rc == 0, err
+    doc = json.loads(out)
+    q1, q2 = np.array(doc["q1"]), np.array(doc["q2"])
+    assert np.max(np.abs(q1**2 + q2**2 - 0.25)) < 1e-9  # the constraint kept along the motion
+    # back at the start after one period 2 pi/omega (printed to 6 digits): within 1e-3 of the
+    # swing's amplitude 0.01/omega (the period's rounding and its amplitude shift, ~1e-6)
+    assert abs(q2[-1]) < 1e-3 * 0.01 / np.sqrt(19.6)
+
+
+def test_the_four_bar_frequency_is_its_operators_at_the_loop_equilibrium(chain):
+    name, _, d, _, q = chain
+    from tests.conftest import ROOT, run_cli
+
+    rc, out, err = run_cli("frequencies", str(ROOT / "tests" / "models" / f"{name}.py"), "--json")
+    assert rc == 0, err
+    doc = json.loads(out)
+    par = {sp.Symbol(p.name): p.default for p in d.model.parameters}
+    at = {sp.Symbol(k): v for k, v in doc["equilibrium"].items()}
+    M, K = (float(X[0].xreplace(par | at)) for X in (d.operator.M, d.operator.K))
+    res = [float(sp.sympify(c).xreplace(par | at)) for c in d.constraints["holonomic"]]
+    assert max(abs(r) for r in res) < 1e-13
+    if K > 0:
+        assert abs(doc["frequencies"][0] - np.sqrt(K / M)) < 1e-12 * np.sqrt(K / M)
+        assert doc["stability"]["class"] == "stable"
+    else:  # the slider-crank at its dead centre: a real pair, one growing at sqrt(-K/M)
+        assert abs(doc["stability"]["growth_rate"] - np.sqrt(-K / M)) < 1e-12 * np.sqrt(-K / M)
+        assert doc["stability"]["class"] == "unstable"
+
+
+def test_independent_coordinates_that_do_not_parametrise_the_equilibrium_are_refused(tmp_path):
+    """The Cartesian pendulum with q1 independent: at its equilibria q2 = 0, where the
+    constraint cannot be solved for q2, and the operator in q1 would be infinite (it was
+    8e22 before, 'marginal'). Refused in one line naming `reduced`."""
+    from tests.conftest import ROOT, run_cli
+
+    src = tmp_path / "nonminimal_q1.py"
+    src.write_text(
+        "import sys\nsys.path.insert(0, %r)\n" % str(ROOT)
+        + "from tests.models.nonminimal_pendulum import system, PARAMETERS\nfrom derive.model import Model\n\n\n"
+        "def build():\n    L, q, hol, loads, N = system()\n"
+        "    return Model(name='nonminimal_q1', title='q1 independent', source='test', module=__name__,\n"
+        "                 parameters=PARAMETERS, coordinates=['q1', 'q2'], coordinate_units={'q1': 'm', 'q2': 'm'},\n"
+        "                 q=q, qd=[], qdd=[], lagrangian=L, loads=loads, frame=N, holonomic=hol)\n")
+    rc, out, err = run_cli("frequencies", str(src))
+    lines = err.strip().splitlines()  # after the first use's notices (deriving, compiling), one line
+    assert rc == 1 and out == "" and all(ln.startswith(("gyro: deriving", "gyro: compiling")) for ln in lines[:-1])
+    assert "cannot be solved for the dependent ones q2" in lines[-1] and "`reduced`" in lines[-1], err

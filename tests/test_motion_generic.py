@@ -12,7 +12,7 @@ import json
 import numpy as np
 import pytest
 
-from tests.conftest import ROOT, run_cli
+from tests.conftest import ROOT, run_cli, error_lines
 
 MODELS = ROOT / "tests" / "models"
 ROTOR = ROOT / "examples" / "rigid_rotor.py"
@@ -79,7 +79,7 @@ def test_a_time_dependent_model_takes_its_time():
 ])
 def test_bad_input_is_one_line_exit_2(args, match):
     rc, out, err = run_cli("simulate", str(MODELS / "damped_oscillator.py"), "--t-end", "1", *args)
-    assert rc == 2 and out == "" and match in err and len(err.strip().splitlines()) == 1, err
+    assert rc == 2 and out == "" and match in err and len(error_lines(err)) == 1, err
 
 
 def test_a_reference_of_given_momenta_is_refused_in_one_line():

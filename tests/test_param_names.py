@@ -10,7 +10,7 @@ import json
 
 import pytest
 
-from tests.conftest import run_cli
+from tests.conftest import run_cli, error_lines
 
 ALIASED = {"gyrohorizoncompass": ("lam", "lambda", 1.05), "gimbal_precession": ("Mmotor", "M_motor", 1e-4)}
 
@@ -23,7 +23,7 @@ def ok(*args) -> str:
 
 def refused(*args, word: str) -> None:
     rc, out, err = run_cli(*args)
-    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1 and word in err, (args, rc, err)
+    assert rc == 2 and out == "" and len(error_lines(err)) == 1 and word in err, (args, rc, err)
 
 
 @pytest.mark.parametrize("model", sorted(ALIASED))

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from gyro import cbackend
-from tests.conftest import ROOT, run_cli
+from tests.conftest import ROOT, run_cli, error_lines
 
 MODELS = ROOT / "tests" / "models"
 CUBIC = str(MODELS / "cubic_spring.py")
@@ -91,7 +91,7 @@ def test_free_fall_has_no_equilibrium():
     model = load(FALL)
     for args in ((), ("--json",)):
         rc, out, err = run_cli("frequencies", FALL, *args)
-        assert rc == 1 and out == "" and len(err.strip().splitlines()) == 1, (rc, out, err)
+        assert rc == 1 and out == "" and len(error_lines(err)) == 1, (rc, out, err)
         assert "no equilibrium" in err and "equation of x keeps a residual of -19.6" in err, err
     P = np.array([model.vector({"g": 9.81}), model.vector({"g": 0.0}), model.vector({"g": -1.0})])
     for solve in (equilibria, lambda m, p: _without_c_iteration(equilibria, m, p)):
@@ -232,7 +232,7 @@ def test_a_point_newton_circles_is_no_equilibrium_unless_it_balances():
     qe, ok = equilibria(model, model.vector(model.parameters({"Kgamma": 1e-9, "g": 0.0, "K0": 1e-6}))[None])
     assert not ok[0] and np.isnan(qe).all()
     rc, out, err = run_cli("frequencies", "torsion_gyrocompass", *args)
-    assert rc == 1 and out == "" and len(err.strip().splitlines()) == 1
+    assert rc == 1 and out == "" and len(error_lines(err)) == 1
     assert "did not converge: the equation of" in err and "keeps a residual" in err, err
 
 

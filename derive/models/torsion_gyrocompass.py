@@ -477,9 +477,11 @@ def section3_formulas():
         put(f"quartic_c{k_}", c, f"(3.10): coefficient of z^{k_} in K0 L(z,b') - z m_* L(z,b'')")
     # the a-priori bounds of the levels on the paper's operator (levels(), docs/hierarchy.md)
     beta0, gamma20 = H * u3 / (G + H * u2), H * u3 / Kgamma
-    paper = put("bound_paper", F["eps2"] + m * g / (Kp * sp.Abs(l2)) + sp.Abs(beta0) + sp.Abs(gamma20) + u / F["Omega"],
+    paper = put("bound_paper", F["eps2"] + m * g / (Kp * sp.Abs(l2)) + sp.Abs(beta0) + sp.Abs(gamma20)
+                + u * (A + I1 + I2 + I3) / H,
                 "the bound of the paper operator (2.4) against the exact one: eps2 + m g/(K_p |l2|) (the "
-                "sag) + |beta0| + |gamma2| of (2.2) + u/Omega")
+                "sag) + |beta0| + |gamma2| of (2.2) + (A + I1 + I2 + I3) u/H (approximation 4: every A u "
+                "and I_i u against H, the casing's as well as the rotor's A u/H = u/Omega)")
     put("bound_blocks", paper + 2 * (H * u2 / Kgamma + H * u2 / G) + 2 * F["eps1"],
         "the bound of the decoupled blocks (u = 0 in (2.4)): bound_paper + 2 (H u2/K_gamma + H u2/G) + 2 eps1")
     return F, doc
@@ -553,7 +555,7 @@ def levels(F):
     motion = {"quantities": list(REDUCED), "scale": "excursion"}
     return [
         Level("formulas", "everything (3.2)-(3.28) drop: each formula's small parameter to its order",
-              {"kind": "spectrum", "method": "formulas"}, {"frequencies": Bound(estimate=True)},
+              {"kind": "spectrum", "method": "formulas", "certify": True}, {"frequencies": Bound(estimate=True)},
               reference="linear_exact",
               doc="the paper's approximate formulas, corrected, with their derived estimates"),
         # costs measured by bench/levels.py (one core, 20,000 sets): since the roots are proven
@@ -564,20 +566,21 @@ def levels(F):
               {"kind": "formulas", "roots": {"function": "paper_charpoly", "block": 2, "set": {"u": 0.0, "g": 0.0},
                                              "modes": ["nutation a", "nutation b", "nutation c", "nutation d"],
                                              "shift": {"parameter": "g", "function": "paper_charpoly_dg", "correct": True},
-                                             "apriori": "bound_blocks"}},
+                                             "apriori": "bound_blocks"}, "certify": True},
               {"frequencies": Bound(estimate=True)},
               valid=blocks_edges,
               cost=4.4e-6, reference="linear_exact",
               doc="the roots of the quartic (3.10) for the four nutation modes, with twice the first-order "
                   "gravity shift of each as its estimate; the other six modes by (3.2)-(3.9)"),
         Level("decoupled", "the Earth-rate coupling of the two blocks (eps1 = 0, (3.1)), and what (2.4) drops",
-              {"kind": "charpoly", "function": "paper_charpoly", "set": {"u": 0.0}},
+              {"kind": "charpoly", "function": "paper_charpoly", "set": {"u": 0.0}, "certify": True},
               {"frequencies": [None] + [Bound(blocks, estimate=True)] * (n - 1)},
               valid=blocks_edges,
               cost=2.9e-6, reference="linear_exact",
               doc="the blocks J', J'' of (2.4) at u = 0: roots of their characteristic polynomials"),
         Level("linear_paper", "linearisation at q = 0 (offsets of (2.2)), u3 terms, u^2 terms, A u and I_i u against H",
-              {"kind": "charpoly", "function": "paper_charpoly"}, {"frequencies": Bound(paper, estimate=True)},
+              {"kind": "charpoly", "function": "paper_charpoly", "certify": True},
+              {"frequencies": Bound(paper, estimate=True)},
               valid={"l2 != 0 (the sag's bound)": sp.Abs(l2)},
               cost=3.0e-6, reference="linear_exact",
               doc="the paper's printed operator (2.4), corrected: roots of its blocks' characteristic polynomials"),

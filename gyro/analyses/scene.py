@@ -40,8 +40,7 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
     names = q.quantities(model, opts)
     idx = q.requested(model, opts)
     N, nq = P.shape[0], len(names)
-    cands = [lv for lv in hierarchy.levels(model) if lv.answers_question(question)
-             and (among is None or lv.name in among)]
+    cands = candidates(model, q, question, idx, among)
     if not cands:
         from gyro.errors import ParameterError
 
@@ -73,11 +72,16 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
         if sub.size == 0:
             continue
         ks = pending[sub]
-        ans = q.answer(model, lv, P[ks], q.subset(opts, ks, N) if hasattr(q, "subset") else opts)
+        ans = answer_per_set(q, model, lv, P[ks], q.subset(opts, ks, N) if hasattr(q, "subset") else opts)
         total = hierarchy.Bounds(B.apriori[sub], B.estimate, B.invalid[sub], B.answered, B.bad[sub]).total(ans.estimate)
         edge = q.edges(model, ans, total, idx, B.answered)
         worst = total[:, idx].max(axis=1) if idx else np.zeros(sub.size)
         failed, crossed = ans.failed != "", edge != ""
+        if lv.evaluator.get("certify") and hasattr(q, "certify"):  # the bound proven against the exact model
+            check = np.flatnonzero(~failed & ~crossed & (worst <= tol))
+            if check.size:
+                edge[check] = q.certify(model, lv, P[ks[check]], ans.take(check), total[check], idx)
+                crossed = edge != ""
         ok = ~failed & ~crossed & (worst <= tol)
         trial.value[ks] = worst
         trial.code[ks] = np.where(ok, ACCEPTED, np.where(failed, FAILED, np.where(crossed, QUESTION_EDGE, BOUND)))
@@ -92,6 +96,60 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
         pending = np.delete(pending, sub[ok])
     return Scene(model.name, question, float(tol), [names[j] for j in idx], level, bound, trials,
                  time.perf_counter() - t0, answers, row)
+
+
+def candidates(model, q, question: str, idx, among=None) -> list:
+    """The levels that answer `question`, in the order the selector tries them: by their
+    cost with their certificate's for the requested quantities (the question's
+    `certificate_cost`, where it has one), ties in the declared order."""
+    cost = getattr(q, "certificate_cost", lambda lv, idx: 0.0)
+    found = [lv for lv in hierarchy.levels(model) if lv.answers_question(question)
+             and (among is None or lv.name in among)]
+    order = sorted(range(len(found)), key=lambda i: (found[i].cost + cost(found[i], idx), i))
+    return [found[i] for i in order]
+
+
+def answer_per_set(q, model, lv, P, opts):
+    """The level's answer over the batch; where it raises for the batch, set by set, so
+    that a set the level cannot answer (no equilibrium, a block without its roots, a
+    singular solve) fails that set only, with the exception's text as its reason. Bad
+    input (ParameterError) is the caller's, not a set's."""
+    from gyro.errors import ParameterError
+    from gyro.questions import Answer
+
+    try:
+        return q.answer(model, lv, P, opts)
+    except ParameterError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - any failure of a level is that level's, per set
+        if P.shape[0] == 1:
+            n = len(q.quantities(model, opts))
+            return Answer(np.full((1, n), np.nan), None, np.array([f"{type(exc).__name__}: {exc}"], object), {})
+    N = P.shape[0]
+    sub = (lambda k: q.subset(opts, np.array([k]), N)) if hasattr(q, "subset") else (lambda k: opts)
+    parts = [answer_per_set(q, model, lv, P[k:k + 1], sub(k)) for k in range(N)]
+    return _joined(parts)
+
+
+def _joined(parts):
+    """One Answer from the answers of single sets (a failed set's values NaN, its estimate
+    inf and its other data NaN, shaped like an answered set's)."""
+    from gyro.questions import Answer
+
+    good = [a for a in parts if a.failed[0] == ""]
+    like = good[0] if good else parts[0]
+    values = np.concatenate([a.values if a.values.shape[1:] == like.values.shape[1:]
+                             else np.full((1,) + like.values.shape[1:], np.nan) for a in parts])
+    est = None
+    if any(a.estimate is not None for a in parts):
+        est = np.concatenate([a.estimate if a.estimate is not None else np.full((1,) + values.shape[1:], np.inf)
+                              for a in parts])
+    extra = {}
+    for key, v in like.extra.items():
+        fill = lambda a: (a.extra[key] if key in a.extra and a.extra[key] is not None  # noqa: E731
+                          else np.full((1,) + np.shape(v)[1:], np.nan))
+        extra[key] = None if v is None else np.concatenate([fill(a) for a in parts])
+    return Answer(values, est, np.concatenate([a.failed for a in parts]), extra)
 
 
 def level_error(model, question: str, level: str, against: str, P, opts: dict | None = None):
@@ -123,9 +181,7 @@ def rungs(model, question: str, P, opts: dict | None = None, until: str | None =
     idx = q.requested(model, opts)
     nq = len(q.quantities(model, opts))
     out, worst = [], []
-    for lv in hierarchy.levels(model):
-        if not lv.answers_question(question):
-            continue
+    for lv in candidates(model, q, question, idx):
         B = hierarchy.bounds(model, lv, question, P, nq)
         if not all(B.answered[j] for j in idx):
             continue

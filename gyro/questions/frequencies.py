@@ -15,6 +15,8 @@ import numpy as np
 
 from gyro.questions import Answer, unknown_kind
 
+EPS = np.finfo(float).eps
+
 NAME = "frequencies"
 VALUES = "frequencies"  # the JSON key of the per-quantity answer (the scene table shows it)
 
@@ -223,6 +225,106 @@ def _say(out: np.ndarray, flags: np.ndarray, text) -> None:
     if rows.size:
         j = np.argmax(flags[rows], axis=1)
         out[rows] = np.array([text(i) for i in range(flags.shape[1])], dtype=object)[j]
+
+
+# s per set and count on one core (bench/levels.py, --certificate): the Hermitian matrix
+# formed, scaled and its eigenvalues by LAPACK (NumPy, batched); the equilibrium and the
+# operator once per set besides
+COUNT_COST = 7.6e-6
+OPERATOR_COST = 3.5e-6
+
+
+def certificate_cost(level, idx) -> float:
+    """The certificate's seconds per set for the requested modes idx (0 for a level that
+    declares none): the operator, the count at 0 (K > 0) and two per requested mode."""
+    if not level.evaluator.get("certify"):
+        return 0.0
+    return OPERATOR_COST + COUNT_COST * (1 + 2 * len(idx))
+
+
+def counts_below(M, D, K, w) -> np.ndarray:
+    """Per set, the number of the exact operator's frequencies below w, proven, or -1 where
+    the count cannot be proven in double precision.
+
+    For a conservative gyroscopic operator (M > 0, K > 0 symmetric, D skew) the roots are
+    lambda = +-i omega and Q(w) = J(i w) = K - w^2 M + i w D is Hermitian. Each eigenvalue
+    mu(w) of Q vanishes where w is a frequency, and there dmu/dw = x* Q'(w) x / x* x =
+    (-2 w x*Mx + i x*Dx)/|x|^2 = -(w x*Mx + x*Kx / w)/|x|^2 < 0 (x*Q(w)x = 0 gives
+    i x*Dx = (w^2 x*Mx - x*Kx)/w): every crossing of zero is from + to -, and Q(0) = K > 0
+    has none negative. So the number of negative eigenvalues of Q(w) is the number of
+    frequencies in (0, w), multiplicities counted. The eigenvalues are LAPACK's of the
+    diagonally scaled S Q S (Sylvester: the same inertia): backward stable, each within
+    8 n eps ||SQS||_F of an eigenvalue of the matrix as formed, whose entries are within 64
+    eps of their magnitude |K| + w^2 |M| + w |D| of the operator's (its forming and the
+    evaluation of the operator); a count is proven where no eigenvalue is within the sum
+    of the two of zero (Weyl)."""
+    n = M.shape[-1]
+    w = np.asarray(w, dtype=float)[:, None, None]
+    with np.errstate(all="ignore"):
+        s = 1 / np.sqrt(np.abs(np.einsum("bii->bi", K)) + w[:, :, 0] ** 2 * np.einsum("bii->bi", M))
+        S = s[:, :, None] * s[:, None, :]
+        Q = (K - w**2 * M + 1j * w * D) * S
+        mag = (np.abs(K) + w**2 * np.abs(M) + w * np.abs(D)) * S
+        good = np.all(np.isfinite(Q), axis=(1, 2)) & np.all(np.isfinite(mag), axis=(1, 2))
+        Q[~good] = np.eye(n)
+        mu = np.linalg.eigvalsh(Q)
+        margin = (8 * n * EPS * np.sqrt(np.sum(Q.real**2 + Q.imag**2, axis=(1, 2)))
+                  + 64 * EPS * np.sqrt(np.sum(mag**2, axis=(1, 2))))
+        proven = good & (np.min(np.abs(mu), axis=1) > margin)
+    return np.where(proven, np.sum(mu < 0, axis=1), -1)
+
+
+def certify(model, level, P, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
+    """'' per set where every requested mode j is proven to be the exact operator's j-th
+    frequency within its bound b (|f - omega_j| <= b omega_j: omega_j in [f/(1+b),
+    f/(1-b)]), the reason otherwise: counts_below at both ends of the interval prove that
+    omega_j lies in it (at most j - 1 frequencies below its lower end, at least j below its
+    upper one), which proves its value and its rank together. Where the count cannot be
+    evaluated (no equilibrium, bearing damping, K not positive definite, a count not
+    resolved in double precision, b >= 1), the set is not answered by the level."""
+    from gyro.equilibrium import equilibria, operators
+    from gyro.kernels import chunks
+    from gyro.qep import gyroscopic
+
+    N = P.shape[0]
+    out = np.full(N, "", object)
+    qe, ok = equilibria(model, P)
+    M, D, K = operators(model, P, qe)
+    ok &= np.all(np.isfinite(M) & np.isfinite(D) & np.isfinite(K), axis=(1, 2))
+    out[~ok] = "certificate: no equilibrium to count the exact operator's frequencies at"
+    gyro_ = ok & gyroscopic(M, D, K)
+    out[ok & ~gyro_] = "certificate: the operator is not conservative gyroscopic (damping): no count"
+    live = np.flatnonzero(gyro_)
+    if live.size == 0:
+        return out
+    M, D, K = M[live], D[live], K[live]
+    f = ans.values[live]
+    b = bound[live]
+    pts, want_lo, want_hi = [np.zeros(live.size)], [], []
+    for j in idx:
+        with np.errstate(all="ignore"):
+            informative = np.isfinite(b[:, j]) & (b[:, j] < 1) & np.isfinite(f[:, j]) & (f[:, j] > 0)
+            bj = np.where(informative, b[:, j], 0.5)
+            pts += [np.where(informative, f[:, j] / (1 + bj), np.nan), np.where(informative, f[:, j] / (1 - bj), np.nan)]
+    W = np.stack(pts, axis=1)  # (sets, 1 + 2 len(idx))
+    n_pts = W.shape[1]
+    c = np.empty(W.shape, int)
+    for s in chunks(live.size, max(1, 8192 // n_pts)):  # bounded memory: a matrix per count
+        rep = lambda X: np.repeat(X[s], n_pts, axis=0)  # noqa: E731
+        c[s] = counts_below(rep(M), rep(D), rep(K), W[s].reshape(-1)).reshape(-1, n_pts)
+    reason = np.full(live.size, "", object)
+    reason[c[:, 0] != 0] = "certificate: K not proven positive definite (no count of the frequencies)"
+    for i, j in enumerate(idx):
+        lo, hi = c[:, 1 + 2 * i], c[:, 2 + 2 * i]
+        unproven = (lo < 0) | (hi < 0)
+        wrong = ~unproven & ((lo > j) | (hi < j + 1))
+        todo = reason == ""
+        reason[todo & unproven] = (f"certificate: mode {j + 1}'s interval not resolved by a count in double "
+                                   "precision (or its bound >= 1)")
+        reason[todo & wrong] = (f"certificate: the exact omega{j + 1} is not within the bound of this "
+                                "answer (a count of the exact operator's frequencies)")
+    out[live] = reason
+    return out
 
 
 def error(ans: Answer, ref: Answer) -> np.ndarray:

@@ -350,6 +350,20 @@ def test_a_cheap_answer_of_another_mode_is_refused_by_its_certificate(tg, level,
         assert abs(f[0] - exact) < 1e-5 * exact
 
 
+def test_the_exact_operators_bound_holds_the_rounding_of_u_cos_phi_near_the_pole(tg):
+    """At 89.9 deg and H/20 the default method's omega1 errs 1.5e-14 against the 40-digit
+    reference (0.0020159754229495193 rad/s, computed once by `reference`, 3 s) while its own
+    estimate said 1.26e-14: the rounding of u cos(phi), eps |x tan x| relative, is in the
+    ladder's bound now (2.1e-13 there); the reference, which takes phi in its own 40 digits,
+    carries only its estimate."""
+    P = tg.vector({"phi": 89.9, "H": tg.defaults["H"] * 0.05})[None, :]
+    s = select(tg, "frequencies", P, 1e-3, {"modes": [1]}, among=["linear_exact:default"])
+    f = s.document(0)["frequencies"][0]
+    assert abs(f - 0.0020159754229495193) / 0.0020159754229495193 <= s.bound[0, 0]
+    ref = hierarchy.bounds(tg, hierarchy.get(tg, "linear_exact:reference"), "frequencies", P, 10)
+    assert np.all(ref.apriori == 0)
+
+
 @settings(max_examples=30, deadline=None, derandomize=True, phases=[Phase.explicit, Phase.generate])
 @given(st.integers(0, 2**31 - 1), st.sampled_from([3e-2, 1e-3, 1e-4, 1e-6, 1e-9]))
 def test_the_actual_error_never_exceeds_the_tolerance(seed, tol):
@@ -460,3 +474,23 @@ def test_a_divergent_real_pair_is_no_neighbour_of_the_slow_mode():
     edge = F.edges(load("gyrohorizoncompass"), F.Answer(f2, e2, np.array([""], object), {}), e2, range(4),
                    np.ones(4, bool))
     assert edge[0] == ""
+
+
+def test_the_linear_forced_levels_estimate_holds_the_solves_conditioning_near_resonance(tg):
+    """1e-5 from the radial resonance (spin H = 0.1404014 kg m^2/s puts omega_c = H/C at
+    1.00001 omega_p' = 780.0078 rad/s) the linear response's solve loses digits as the
+    condition of J(i w): an error of 7e-12 was measured there against an estimate of 1e-15
+    (its floor) at 1e-9 N; the estimate now carries 4 n eps kappa(J_s), which the example's
+    spin, far from any resonance, keeps near its floor."""
+    from gyro.analyses import forced
+    from gyro.questions.forced import solve_rounding
+
+    def rounding(values):  # the linear response as harmonic_balance starts from it, per unit group
+        p = tg.vector(values)
+        S = forced._Periodic(tg, dict(zip(tg.param_names, p)), (1, 1, 1e-9, 0.0))
+        units = np.array([tg.meta["coordinate_units"][c] for c in tg.meta["reduced"]])
+        group = np.array([np.abs(S.X_lin)[units == u].max() for u in units])
+        return solve_rounding(tg, p, S.w, S.X_lin, group)
+
+    near, far = rounding({"H": 0.1404014040024418}), rounding({})
+    assert np.all(near > 7e-12) and np.all(far < 1e-12)

@@ -62,7 +62,9 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
             continue
         pre = B.apriori[:, idx].max(axis=1) if idx else np.zeros(pending.size)
         beyond = B.bad
-        hopeful = ~beyond & (pre <= tol)
+        # a level with a certificate may prove the tolerance itself where its own bound is larger
+        certifying = bool(lv.evaluator.get("certify")) and hasattr(q, "certify")
+        hopeful = ~beyond & ((pre <= tol) | certifying)
         trial.code[pending[beyond]] = EDGE
         if beyond.any():
             trial.say(pending[beyond], B.invalid[beyond])
@@ -74,14 +76,13 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
         ks = pending[sub]
         ans = answer_per_set(q, model, lv, P[ks], q.subset(opts, ks, N) if hasattr(q, "subset") else opts)
         total = hierarchy.Bounds(B.apriori[sub], B.estimate, B.invalid[sub], B.answered, B.bad[sub]).total(ans.estimate)
-        edge = q.edges(model, ans, total, idx, B.answered)
+        failed = ans.failed != ""
+        if certifying:
+            total, edge = proven(q, model, lv, P[ks], ans, total, idx, tol)
+        else:
+            edge = q.edges(model, ans, total, idx, B.answered)
         worst = total[:, idx].max(axis=1) if idx else np.zeros(sub.size)
-        failed, crossed = ans.failed != "", edge != ""
-        if lv.evaluator.get("certify") and hasattr(q, "certify"):  # the bound proven against the exact model
-            check = np.flatnonzero(~failed & ~crossed & (worst <= tol))
-            if check.size:
-                edge[check] = q.certify(model, lv, P[ks[check]], ans.take(check), total[check], idx)
-                crossed = edge != ""
+        crossed = edge != ""
         ok = ~failed & ~crossed & (worst <= tol)
         trial.value[ks] = worst
         trial.code[ks] = np.where(ok, ACCEPTED, np.where(failed, FAILED, np.where(crossed, QUESTION_EDGE, BOUND)))
@@ -96,6 +97,28 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
         pending = np.delete(pending, sub[ok])
     return Scene(model.name, question, float(tol), [names[j] for j in idx], level, bound, trials,
                  time.perf_counter() - t0, answers, row)
+
+
+def proven(q, model, lv, P, ans, total, idx, tol):
+    """The bound a level's certificate proves per set and requested quantity, and per set
+    the reason where it proves none: its own bound where that is <= tol, else tol itself
+    (the certificate proves an interval of any width: a cheap answer whose own bound is
+    pessimistic is taken where it is within tol of the exact model); where its own bound
+    fails the proof, tol is tried. inf where nothing is proven; the rank of each mode is
+    proven with it, so no neighbour's interval is an edge."""
+    claim = np.where(total <= tol, total, tol)
+    reason = np.full(P.shape[0], "", object)
+    live = np.flatnonzero(ans.failed == "")
+    if live.size and idx:
+        reason[live] = q.certify(model, lv, P[live], ans.take(live), claim[live], idx)
+        again = live[(reason[live] != "") & np.any(claim[live][:, idx] < tol, axis=1)]
+        if again.size:
+            wide = np.full((again.size, claim.shape[1]), tol)
+            second = q.certify(model, lv, P[again], ans.take(again), wide, idx)
+            took = again[second == ""]
+            claim[took], reason[took] = tol, ""
+    claim[reason != ""] = np.inf
+    return claim, reason
 
 
 def candidates(model, q, question: str, idx, among=None) -> list:
@@ -169,12 +192,13 @@ def level_error(model, question: str, level: str, against: str, P, opts: dict | 
 
 
 def rungs(model, question: str, P, opts: dict | None = None, until: str | None = None) -> list:
-    """The levels the selector can take for `question` on the sets P, cheapest first: those
-    that answer every requested quantity and are not dominated on P, a level being
-    dominated where a cheaper one's largest bound over the requested quantities is no
-    larger on every set (the quartic level behind the paper operator's blocks: its nutation
-    roots carry the blocks' bound and more). The rungs of the hierarchy's property tests;
-    `until` names the last level looked at (the costlier ones are not run)."""
+    """The levels the selector can take for `question` on the sets P, in its order for this
+    request (`candidates`): those that answer every requested quantity and are not
+    dominated on P, a level being dominated where a cheaper one's largest bound over the
+    requested quantities is no larger on every set. A level with a certificate is never
+    dominated: it may prove the tolerance where its own bound says less. The rungs of the
+    hierarchy's property tests; `until` names the last level looked at (the costlier ones
+    are not run)."""
     opts = dict(opts or {})
     q = questions.get(question)
     P = as_batch(model, P)
@@ -185,11 +209,13 @@ def rungs(model, question: str, P, opts: dict | None = None, until: str | None =
         B = hierarchy.bounds(model, lv, question, P, nq)
         if not all(B.answered[j] for j in idx):
             continue
+        certifying = bool(lv.evaluator.get("certify")) and hasattr(q, "certify")
         w = B.total(q.answer(model, lv, P, opts).estimate)[:, idx].max(axis=1)
-        if any(np.all(v <= w) for v in worst):
+        if not certifying and any(np.all(v <= w) for v in worst):
             continue
         out.append(lv.name)
-        worst.append(w)
+        if not certifying:
+            worst.append(w)
         if lv.name == until:
             break
     return out

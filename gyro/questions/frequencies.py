@@ -231,11 +231,14 @@ def _say(out: np.ndarray, flags: np.ndarray, text) -> None:
         out[rows] = np.array([text(i) for i in range(flags.shape[1])], dtype=object)[j]
 
 
-# s per set and count on one core (bench/levels.py, --certificate): the Hermitian matrix
-# formed, scaled and its eigenvalues by LAPACK (NumPy, batched); the equilibrium and the
-# operator once per set besides
-COUNT_COST = 7.6e-6
-OPERATOR_COST = 3.5e-6
+# s per set and count on one core, on the scale of the methods' COST (linear_exact:default
+# 3.6e-5): the Hermitian matrix formed, scaled and its eigenvalues by LAPACK (NumPy,
+# batched), 2.1x the default method's time for the three counts of one mode and 14x for
+# the 21 of all ten (python -m bench.levels --random-speed, levels.json 'random_speed');
+# the equilibrium and the operator once per set besides. So the certificate costs a cheap
+# level more than its advantage on any request: the selector tries the exact operator first
+COUNT_COST = 2.4e-5
+OPERATOR_COST = 3.4e-6
 
 
 def certificate_cost(level, idx) -> float:

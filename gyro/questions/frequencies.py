@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from gyro.kernels import chunks
 from gyro.questions import Answer, unknown_kind
 
 EPS = np.finfo(float).eps
@@ -231,14 +232,14 @@ def _say(out: np.ndarray, flags: np.ndarray, text) -> None:
         out[rows] = np.array([text(i) for i in range(flags.shape[1])], dtype=object)[j]
 
 
-# s per set and count on one core, on the scale of the methods' COST (linear_exact:default
-# 3.6e-5): the Hermitian matrix formed, scaled and its eigenvalues by LAPACK (NumPy,
-# batched), 2.1x the default method's time for the three counts of one mode and 14x for
-# the 21 of all ten (python -m bench.levels --random-speed, levels.json 'random_speed');
-# the equilibrium and the operator once per set besides. So the certificate costs a cheap
-# level more than its advantage on any request: the selector tries the exact operator first
-COUNT_COST = 2.4e-5
-OPERATOR_COST = 3.4e-6
+# s per set on one core, on the scale of the methods' COST (linear_exact:default 3.6e-5 s):
+# a count (the compiled Bunch-Kaufman inertia, counts_at) and the rest of a certificate
+# (the equilibrium, the operator, the bookkeeping), from one run of
+# `python -m bench.levels --random-speed` (levels.json 'random_speed': one mode's certificate
+# 0.59x the default method's time, ten modes' 2.7x). So the certificate leaves a cheap level
+# its advantage for one or two requested modes, and costs more than it for three and more
+COUNT_COST = 4.1e-6
+OPERATOR_COST = 8.7e-6
 
 
 def certificate_cost(level, idx) -> float:
@@ -281,6 +282,52 @@ def counts_below(M, D, K, w) -> np.ndarray:
     return np.where(proven, np.sum(mu < 0, axis=1), -1)
 
 
+def counts_at(M, D, K, W) -> np.ndarray:
+    """counts_below at the points W (sets, points) of each set: the compiled twin
+    (gyro/questions/inertia.c: Bunch-Kaufman's LDL^H of the same scaled matrix, its inertia
+    that of the blocks, proven by the factorization's backward error against the smallest
+    block over ||L^-1||_F^2) where a compiler is at hand, else LAPACK's eigenvalues in NumPy.
+    -> (sets, points), -1 where not proven."""
+    from gyro import cbackend
+
+    N, Pn = W.shape
+    try:
+        fn = _inertia_kernel()
+    except cbackend.CompilerUnavailable:
+        c = np.empty(W.shape, int)
+        for s in chunks(N, max(1, 8192 // max(Pn, 1))):  # bounded memory: a matrix per count
+            rep = lambda X: np.repeat(X[s], Pn, axis=0)  # noqa: E731
+            c[s] = counts_below(rep(M), rep(D), rep(K), W[s].reshape(-1)).reshape(-1, Pn)
+        return c
+    import ctypes
+
+    arrs = [np.ascontiguousarray(X, dtype=float) for X in (M, D, K, W)]
+    out = np.empty(W.shape)
+    ptr = ctypes.POINTER(ctypes.c_double)
+    fn(ctypes.c_long(N), ctypes.c_long(M.shape[-1]), ctypes.c_long(Pn),
+       *[a.ctypes.data_as(ptr) for a in arrs + [out]])
+    c = out.astype(int)
+    # the factorization's bound is the weaker near a frequency (1.4 % of the points at a
+    # relative 1e-7 from one, where LAPACK's eigenvalues prove all): those again in NumPy
+    k, p = np.nonzero((c < 0) & np.isfinite(W) & (W >= 0))
+    if k.size:
+        c[k, p] = counts_below(M[k], D[k], K[k], W[k, p])
+    return c
+
+
+def _inertia_kernel():
+    """The compiled count (gyro/questions/inertia.c, built once per machine as a model's C
+    is); CompilerUnavailable where there is none, or within cbackend.disabled()."""
+    from pathlib import Path
+
+    from gyro import cbackend
+
+    cbackend._available()
+    fn = cbackend._library(str(Path(__file__).parent), "inertia").gyro_inertia_counts
+    fn.restype = None
+    return fn
+
+
 def certify(model, level, P, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
     """'' per set where every requested mode j is proven to be the exact operator's j-th
     frequency within its bound b (|f - omega_j| <= b omega_j: omega_j in [f/(1+b),
@@ -290,7 +337,6 @@ def certify(model, level, P, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
     evaluated (no equilibrium, bearing damping, K not positive definite, a count not
     resolved in double precision, b >= 1), the set is not answered by the level."""
     from gyro.equilibrium import equilibria, operators
-    from gyro.kernels import chunks
     from gyro.qep import gyroscopic
 
     N = P.shape[0]
@@ -314,11 +360,9 @@ def certify(model, level, P, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
             bj = np.where(informative, b[:, j], 0.5)
             pts += [np.where(informative, f[:, j] / (1 + bj), np.nan), np.where(informative, f[:, j] / (1 - bj), np.nan)]
     W = np.stack(pts, axis=1)  # (sets, 1 + 2 len(idx))
-    n_pts = W.shape[1]
-    c = np.empty(W.shape, int)
-    for s in chunks(live.size, max(1, 8192 // n_pts)):  # bounded memory: a matrix per count
-        rep = lambda X: np.repeat(X[s], n_pts, axis=0)  # noqa: E731
-        c[s] = counts_below(rep(M), rep(D), rep(K), W[s].reshape(-1)).reshape(-1, n_pts)
+    with np.errstate(invalid="ignore"):
+        c = counts_at(M, D, K, np.where(np.isfinite(W), W, -1.0))
+    c[~np.isfinite(W)] = -1
     reason = np.full(live.size, "", object)
     reason[c[:, 0] != 0] = "certificate: K not proven positive definite (no count of the frequencies)"
     for i, j in enumerate(idx):

@@ -609,3 +609,16 @@ def test_the_exact_levels_bound_holds_against_the_40_digit_reference(seed, modes
     exact = ladder.spectrum(tg, P, "reference").frequencies[0, idx]
     f = np.array(s.document(0)["frequencies"])
     assert np.all(np.abs(f - exact) <= (s.bound[0] + 1.2e-16) * exact), (s.level[0], s.bound[0])
+
+
+def test_a_certificate_at_the_pole_carries_the_rounding_of_u_cos_phi(tg):
+    """At 90 deg the double-precision operator keeps u cos(phi) = 4.5e-21 (cos of pi/2
+    rounded) where the exact model has none, so its omega1 (1.3e-10 rad/s by the formula,
+    which the count of that operator confirms) is not the exact model's: the certificate
+    adds linear_exact's input term, eps (|x tan x| + 1), which is 5.6 there, and refuses;
+    at 89.99999 deg (the term 3.5e-10) the formula is proven."""
+    P = tg.vector({"phi": 90.0})[None, :]
+    s = select(tg, "frequencies", P, 1e-3, {"modes": [1]}, among=["formulas"])
+    assert s.level[0] == "" and "rounding of the inputs" in dict(s.tried(0))["formulas"]
+    s = select(tg, "frequencies", tg.vector({"phi": 89.99999})[None, :], 1e-3, {"modes": [1]}, among=["formulas"])
+    assert s.level[0] == "formulas"

@@ -78,7 +78,7 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
         total = hierarchy.Bounds(B.apriori[sub], B.estimate, B.invalid[sub], B.answered, B.bad[sub]).total(ans.estimate)
         failed = ans.failed != ""
         if certifying:
-            total, edge = proven(q, model, lv, P[ks], ans, total, idx, tol)
+            total, edge = proven(q, model, lv, P[ks], ans, total, idx, tol, question)
         else:
             edge = q.edges(model, ans, total, idx, B.answered)
         worst = total[:, idx].max(axis=1) if idx else np.zeros(sub.size)
@@ -99,26 +99,40 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
                  time.perf_counter() - t0, answers, row)
 
 
-def proven(q, model, lv, P, ans, total, idx, tol):
+def proven(q, model, lv, P, ans, total, idx, tol, question: str = "frequencies"):
     """The bound a level's certificate proves per set and requested quantity, and per set
-    the reason where it proves none: its own bound where that is <= tol, else tol itself
-    (the certificate proves an interval of any width: a cheap answer whose own bound is
-    pessimistic is taken where it is within tol of the exact model); where its own bound
-    fails the proof, tol is tried. inf where nothing is proven; the rank of each mode is
-    proven with it, so no neighbour's interval is an edge."""
-    claim = np.where(total <= tol, total, tol)
+    the reason where it proves none: its own bound where that is within reach, else tol
+    itself (the certificate proves an interval of any width: a cheap answer whose own bound
+    is pessimistic is taken where it is within tol of the exact model); where its own bound
+    fails the proof, tol is tried. The certificate judges the exact model as evaluated in
+    double precision; with {"certify": {"inputs": LEVEL}} the a-priori part of LEVEL's bound
+    (the rounding of the inputs, u cos(phi) near the pole) separates that from the exact
+    model: a proven c and an input term t make c + t + c t, so c is at most
+    (tol - t)/(1 + t). inf where nothing is proven; the rank of each mode is proven with
+    it, so no neighbour's interval is an edge."""
+    spec = lv.evaluator.get("certify")
+    t = np.zeros(total.shape)
+    if isinstance(spec, dict) and spec.get("inputs"):
+        ref = hierarchy.get(model, spec["inputs"])
+        t = hierarchy.bounds(model, ref, question, P, total.shape[1]).apriori
+        t = np.where(np.isfinite(t), t, np.inf)
+    with np.errstate(invalid="ignore"):
+        room = (tol - t) / (1 + t)
+    claim = np.where(total <= room, total, room)
     reason = np.full(P.shape[0], "", object)
-    live = np.flatnonzero(ans.failed == "")
+    short = ~np.all(room[:, idx] > 0, axis=1) if idx else np.zeros(P.shape[0], bool)
+    reason[short] = "certificate: the rounding of the inputs alone exceeds the tolerance"
+    live = np.flatnonzero((ans.failed == "") & ~short)
     if live.size and idx:
         reason[live] = q.certify(model, lv, P[live], ans.take(live), claim[live], idx)
-        again = live[(reason[live] != "") & np.any(claim[live][:, idx] < tol, axis=1)]
+        again = live[(reason[live] != "") & np.any(claim[live][:, idx] < room[live][:, idx], axis=1)]
         if again.size:
-            wide = np.full((again.size, claim.shape[1]), tol)
-            second = q.certify(model, lv, P[again], ans.take(again), wide, idx)
+            second = q.certify(model, lv, P[again], ans.take(again), room[again], idx)
             took = again[second == ""]
-            claim[took], reason[took] = tol, ""
-    claim[reason != ""] = np.inf
-    return claim, reason
+            claim[took], reason[took] = room[took], ""
+    out = claim + t + claim * t
+    out[reason != ""] = np.inf
+    return out, reason
 
 
 def candidates(model, q, question: str, idx, among=None) -> list:

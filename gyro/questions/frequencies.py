@@ -236,7 +236,7 @@ def _say(out: np.ndarray, flags: np.ndarray, text) -> None:
 # a count (the compiled Bunch-Kaufman inertia, counts_at) and the rest of a certificate
 # (the equilibrium, the operator, the bookkeeping), from one run of
 # `python -m bench.levels --random-speed` (levels.json 'random_speed': one mode's certificate
-# 0.59x the default method's time, ten modes' 2.7x). So the certificate leaves a cheap level
+# 0.72x the default method's time, ten modes' 3.0x..4.2x). So the certificate leaves a cheap level
 # its advantage for one or two requested modes, and costs more than it for three and more
 COUNT_COST = 4.1e-6
 OPERATOR_COST = 8.7e-6
@@ -282,13 +282,18 @@ def counts_below(M, D, K, w) -> np.ndarray:
     return np.where(proven, np.sum(mu < 0, axis=1), -1)
 
 
+NOT_GYROSCOPIC = -2  # counts_at: M or K not symmetric, or D not skew, to the bit (no count)
+
+
 def counts_at(M, D, K, W) -> np.ndarray:
     """counts_below at the points W (sets, points) of each set: the compiled twin
     (gyro/questions/inertia.c: Bunch-Kaufman's LDL^H of the same scaled matrix, its inertia
     that of the blocks, proven by the factorization's backward error against the smallest
     block over ||L^-1||_F^2) where a compiler is at hand, else LAPACK's eigenvalues in NumPy.
-    -> (sets, points), -1 where not proven."""
+    -> (sets, points), -1 where not proven, NOT_GYROSCOPIC for every point of a set whose
+    operator is not conservative gyroscopic (bearing damping)."""
     from gyro import cbackend
+    from gyro.qep import gyroscopic
 
     N, Pn = W.shape
     try:
@@ -298,6 +303,7 @@ def counts_at(M, D, K, W) -> np.ndarray:
         for s in chunks(N, max(1, 8192 // max(Pn, 1))):  # bounded memory: a matrix per count
             rep = lambda X: np.repeat(X[s], Pn, axis=0)  # noqa: E731
             c[s] = counts_below(rep(M), rep(D), rep(K), W[s].reshape(-1)).reshape(-1, Pn)
+        c[~gyroscopic(M, D, K)] = NOT_GYROSCOPIC
         return c
     import ctypes
 
@@ -309,7 +315,7 @@ def counts_at(M, D, K, W) -> np.ndarray:
     c = out.astype(int)
     # the factorization's bound is the weaker near a frequency (1.4 % of the points at a
     # relative 1e-7 from one, where LAPACK's eigenvalues prove all): those again in NumPy
-    k, p = np.nonzero((c < 0) & np.isfinite(W) & (W >= 0))
+    k, p = np.nonzero((c == -1) & np.isfinite(W) & (W >= 0))
     if k.size:
         c[k, p] = counts_below(M[k], D[k], K[k], W[k, p])
     return c
@@ -337,34 +343,29 @@ def certify(model, level, P, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
     evaluated (no equilibrium, bearing damping, K not positive definite, a count not
     resolved in double precision, b >= 1), the set is not answered by the level."""
     from gyro.equilibrium import equilibria, operators
-    from gyro.qep import gyroscopic
 
     N = P.shape[0]
     out = np.full(N, "", object)
     qe, ok = equilibria(model, P)
-    M, D, K = operators(model, P, qe)
-    ok &= np.all(np.isfinite(M) & np.isfinite(D) & np.isfinite(K), axis=(1, 2))
     out[~ok] = "certificate: no equilibrium to count the exact operator's frequencies at"
-    gyro_ = ok & gyroscopic(M, D, K)
-    out[ok & ~gyro_] = "certificate: the operator is not conservative gyroscopic (damping): no count"
-    live = np.flatnonzero(gyro_)
+    live = np.flatnonzero(ok)
     if live.size == 0:
         return out
-    M, D, K = M[live], D[live], K[live]
-    f = ans.values[live]
-    b = bound[live]
-    pts, want_lo, want_hi = [np.zeros(live.size)], [], []
-    for j in idx:
-        with np.errstate(all="ignore"):
+    every = live.size == N  # no copies of the batch's operators where every set has its equilibrium
+    M, D, K = operators(model, P if every else P[live], qe if every else qe[live])
+    f = ans.values if every else ans.values[live]
+    b = bound if every else bound[live]
+    W = np.zeros((live.size, 1 + 2 * len(idx)))
+    with np.errstate(all="ignore"):
+        for i, j in enumerate(idx):
             informative = np.isfinite(b[:, j]) & (b[:, j] < 1) & np.isfinite(f[:, j]) & (f[:, j] > 0)
-            bj = np.where(informative, b[:, j], 0.5)
-            pts += [np.where(informative, f[:, j] / (1 + bj), np.nan), np.where(informative, f[:, j] / (1 - bj), np.nan)]
-    W = np.stack(pts, axis=1)  # (sets, 1 + 2 len(idx))
-    with np.errstate(invalid="ignore"):
-        c = counts_at(M, D, K, np.where(np.isfinite(W), W, -1.0))
-    c[~np.isfinite(W)] = -1
+            W[:, 1 + 2 * i] = np.where(informative, f[:, j] / (1 + b[:, j]), -1.0)
+            W[:, 2 + 2 * i] = np.where(informative, f[:, j] / (1 - b[:, j]), -1.0)
+    c = counts_at(M, D, K, W)
+    c[W < 0] = -1
     reason = np.full(live.size, "", object)
-    reason[c[:, 0] != 0] = "certificate: K not proven positive definite (no count of the frequencies)"
+    reason[c[:, 0] == NOT_GYROSCOPIC] = "certificate: the operator is not conservative gyroscopic (damping): no count"
+    reason[(c[:, 0] != 0) & (reason == "")] = "certificate: K not proven positive definite (no count of the frequencies)"
     for i, j in enumerate(idx):
         lo, hi = c[:, 1 + 2 * i], c[:, 2 + 2 * i]
         unproven = (lo < 0) | (hi < 0)

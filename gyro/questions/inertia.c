@@ -9,7 +9,8 @@
  * operator's; L B L^H has no eigenvalue within 1 / ||L^-H B^-1 L^-1||_F of zero (the inverse
  * formed from the factors; its rounding held to a quarter by n eps cond_F(L) < 1/4, whence the
  * factor 2 below). Where twice the perturbations stay below that, Weyl's inequality leaves
- * every sign as computed and the count is written; -1 otherwise.
+ * every sign as computed and the count is written; -1 otherwise, and -2 at every point of a
+ * set whose M or K is not symmetric or D not skew (bearing damping: no such count).
  * M, D, K are (N, n, n) row-major, w (N, P), out (N, P); n <= 32. Complex numbers are pairs
  * of doubles (C99's complex product calls a library routine for its infinities). */
 #include <math.h>
@@ -189,11 +190,23 @@ static double count_one(long n, const double *M, const double *D, const double *
     return (double)negative;
 }
 
+/* M and K symmetric and D skew to the bit: the structure the count rests on */
+static int gyroscopic(long n, const double *M, const double *D, const double *K)
+{
+    for (long i = 0; i < n; i++)
+        for (long j = 0; j <= i; j++)
+            if (M[i * n + j] != M[j * n + i] || K[i * n + j] != K[j * n + i] || D[i * n + j] != -D[j * n + i])
+                return 0;
+    return 1;
+}
+
 void gyro_inertia_counts(long N, long n, long P, const double *M, const double *D, const double *K,
                          const double *w, double *out)
 {
-    for (long b = 0; b < N; b++)
+    for (long b = 0; b < N; b++) {
+        const double *Mb = M + b * n * n, *Db = D + b * n * n, *Kb = K + b * n * n;
+        int structured = gyroscopic(n, Mb, Db, Kb);
         for (long p = 0; p < P; p++)
-            out[b * P + p] = (n > NMAX) ? -1.0
-                : count_one(n, M + b * n * n, D + b * n * n, K + b * n * n, w[b * P + p]);
+            out[b * P + p] = !structured ? -2.0 : (n > NMAX) ? -1.0 : count_one(n, Mb, Db, Kb, w[b * P + p]);
+    }
 }

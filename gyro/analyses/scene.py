@@ -161,7 +161,8 @@ def answer_per_set(q, model, lv, P, opts):
     except Exception as exc:  # noqa: BLE001 - any failure of a level is that level's, per set
         if P.shape[0] == 1:
             n = len(q.quantities(model, opts))
-            return Answer(np.full((1, n), np.nan), None, np.array([f"{type(exc).__name__}: {exc}"], object), {})
+            text = (str(exc).splitlines() or [""])[0]  # one line: the reason is a table row
+            return Answer(np.full((1, n), np.nan), None, np.array([f"{type(exc).__name__}: {text}"], object), {})
     N = P.shape[0]
     sub = (lambda k: q.subset(opts, np.array([k]), N)) if hasattr(q, "subset") else (lambda k: opts)
     parts = [answer_per_set(q, model, lv, P[k:k + 1], sub(k)) for k in range(N)]

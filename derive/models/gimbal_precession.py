@@ -375,12 +375,19 @@ def levels():
 
     valid = {"|beta0| < 90 deg (13) regular": sp.cos(beta0) - sp.Rational(1, 1000),
              "|alpha0| < 90 deg (the image point in the plane)": sp.cos(alpha0) - sp.Rational(1, 1000)}
+    # the precession is the slow motion only while the base turns slowly against the nutation,
+    # whose frequency is at least H |cos beta|/J (J every moment besides the rotor's momentum):
+    # the runtime holds the same ratio along the motion with the frames' own rates added
+    # (gyro.analyses.precession.NUTATION_RATIO)
+    J = C1 + C2 + C3 + B1 + B2 + B3 + 2 * A1 + A3
+    slow = {**valid, "|u| J/(H cos beta0) < 1/10 (the base slow against the nutation)":
+            H * sp.Abs(sp.cos(beta0)) / 10 - sp.sqrt(u_xi**2 + u_eta**2 + u_zeta**2) * J}
     out = []
     for name in ("elementary", "small", "rigorous", "image", "full"):
         out.append(Level(name, NEGLECTS[name],
                          {"kind": "trajectory", "analysis": "precession", "method": name, "quantities": ["x", "y"],
                           "scale": "excursion"},
-                         {"motion": Bound(estimate=True)}, valid=valid, cost=COSTS[name],
+                         {"motion": Bound(estimate=True)}, valid=valid if name == "full" else slow, cost=COSTS[name],
                          reference=None if name == "full" else "full",
                          doc=f"level '{name}' of the precession hierarchy"))
     return out

@@ -646,15 +646,16 @@ def integration_error(values: dict, m) -> float:
 
 
 def bound(values: dict, m) -> float:
-    """The relative error bound of motion m (one level's) against `full` (see above)."""
+    """The relative error bound of motion m (one level's) against `full` (see above),
+    relative to the exact motion's excursion: an absolute bound b E on the level's
+    excursion E is b/(1 - b) of the exact one's, which is at least E (1 - b) (both start
+    at the same point); infinite from b = 1."""
     scale = _scale(m)
     if not scale > 0:
         return float("inf")
     integ = integration_error(values, m)
-    if m.level == "full":
-        return integ / scale
-    out = (SAFETY * model_error(values, m) + integ) / scale
-    return out if np.isfinite(out) else float("inf")
+    b = (integ if m.level == "full" else SAFETY * model_error(values, m) + integ) / scale
+    return b / (1 - b) if b < 1 else float("inf")
 
 
 INITIAL: dict = {}  # the initial state is the parameters' (alpha0, beta0, H): no extra conditions

@@ -11,7 +11,8 @@ Levels, most exact first (docs/precession.md):
 Each precession level is emitted as a linear system A r = b in its rates r (the friction
 moments carry the rates), solved at each step.
 Every level is integrated by CasADi's CVODES (Adams, rtol 1e-12) over the generated CasADi
-functions, one integrator per level built once with the parameters as its input.
+functions, one integrator per level built once with the parameters as its input (the bound
+integrates it again by BDF, `multistep="bdf"`, an independent method).
 The image point and the angles are converted by the generated `image_point` and
 `angles_of_image`. (13) is singular at beta = +-90 deg, and the image point leaves the
 picture plane at alpha = +-90 deg: a motion that reaches either (|cos| < 1e-3) is refused.

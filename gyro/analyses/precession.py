@@ -616,20 +616,25 @@ def _bound_grid(values: dict, m):
     return m if n <= len(m.t) else simulate(values, np.linspace(0.0, float(m.t[-1]), n), m.level)
 
 
+def slow_against_nutation(values: dict, m) -> bool:
+    """(|u| + |alpha'| + |beta'|) J/(H |cos beta|) <= NUTATION_RATIO at every sample of m
+    (alpha', beta' those of (13))."""
+    r3 = _rigorous(vector(values), m.alpha, m.beta, m.H)
+    u = float(np.linalg.norm([values[b] for b in BASE]))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = (u + np.abs(r3[:, 0]) + np.abs(r3[:, 1])) * transverse_inertia(values) / (
+            np.abs(m.H) * np.abs(np.cos(m.beta)))
+    return bool(np.all(ratio <= NUTATION_RATIO))
+
+
 def model_error(values: dict, m) -> float:
     """The first-order estimate of the largest |P_level - P_full| over the horizon (absolute,
     before SAFETY); inf where the precession is not the slow motion or the grid would be too
     fine (see above)."""
-    g = _bound_grid(values, m)
-    if g is None:
+    if not slow_against_nutation(values, m):  # on the answer's samples first: no finer grid for a refusal
         return float("inf")
-    P = vector(values)
-    r3 = _rigorous(P, g.alpha, g.beta, g.H)
-    J = transverse_inertia(values)
-    with np.errstate(divide="ignore"):
-        ratio = (float(np.linalg.norm([values[b] for b in BASE])) + np.abs(r3[:, 0]) + np.abs(r3[:, 1])) * J / (
-            np.abs(g.H) * np.abs(np.cos(g.beta)))
-    if not np.all(ratio <= NUTATION_RATIO):
+    g = _bound_grid(values, m)
+    if g is None or not slow_against_nutation(values, g):
         return float("inf")
     D = defect(values, g)
     d = np.sqrt((np.cos(g.beta) * D[:, 0])**2 + D[:, 1]**2 + (D[:, 2] / abs(float(values["H"])))**2)
@@ -654,8 +659,10 @@ def bound(values: dict, m) -> float:
     scale = _scale(m)
     if not scale > 0:
         return float("inf")
-    integ = integration_error(values, m)
-    b = (integ if m.level == "full" else SAFETY * model_error(values, m) + integ) / scale
+    model = 0.0 if m.level == "full" else SAFETY * model_error(values, m)
+    if not model / scale < 1:  # no bound: the integrator's runs are not needed
+        return float("inf")
+    b = (model + integration_error(values, m)) / scale
     return b / (1 - b) if b < 1 else float("inf")
 
 

@@ -53,21 +53,18 @@ class Singular(ParameterError):
     (where the image point leaves the picture plane)."""
 
 
-def cli_name(name: str) -> str:
-    """The name a user types for a parameter (the model's aliases: M_motor for Mmotor)."""
-    return {v: k for k, v in load(MODEL).meta.get("aliases", {}).items()}.get(name, name)
-
-
 def parameters(sets: dict | None = None) -> dict:
     """Model values (by model symbol) from NAME=VALUE text or numbers by command-line name;
     each checked (unknown name, not a number, NaN, inf, a non-positive inertia or H, an
     angle out of range): ParameterError naming it."""
     model = load(MODEL)
-    known = [cli_name(n) for n in model.param_names]
+    known = [*model.param_names, *model.aliases]  # the declared names, and M_motor for Mmotor
     out = {}
     for key, raw in (sets or {}).items():
         if key not in known:
-            raise ParameterError(f"unknown parameter {key!r} for {MODEL}; known: {' '.join(known)}")
+            raise ParameterError(f"unknown parameter {key!r} for {MODEL}; known: {model.known_names()}")
+        if model.canonical(key) in out:
+            raise ParameterError(f"parameter {model.canonical(key)}: given twice (as {key} and another name)")
         out[model.canonical(key)] = finite_number(f"parameter {key}", raw)
     return model.parameters(out)
 
@@ -77,8 +74,8 @@ def vector(values: dict) -> np.ndarray:
 
 
 def named(values: dict) -> dict:
-    """The values by their command-line names."""
-    return {cli_name(k): float(v) for k, v in values.items()}
+    """The values by their declared names, and by M_motor (the JSON's key before) too."""
+    return load(MODEL).named(values)
 
 
 @lru_cache(maxsize=64)

@@ -22,7 +22,7 @@ TIERS = {
     "paper": ("test_paper", "test_anchors", "test_nonlinear", "test_gimbal", "test_gimbal_closed_form",
               "test_gimbal_section6", "test_gimbal_paper_items", "test_paper_items",
               "test_gyrohorizoncompass", "test_verdict", "test_ghc_paper_items", "test_ghc_motion", "test_precession",
-              "test_precession_base"),
+              "test_precession_base", "test_precession_bounds"),
     "methods": ("test_ladder", "test_companion_bound", "test_sensitivity", "test_hierarchy", "test_torsion_motion",
                 "test_scene_figures", "test_harmonic", "test_block_starts", "test_anymodel", "test_roots",
                 "test_equilibrium_c", "test_rightmodel"),

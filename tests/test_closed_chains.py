@@ -199,3 +199,30 @@ def test_independent_coordinates_that_do_not_parametrise_the_equilibrium_are_ref
     lines = err.strip().splitlines()  # after the first use's notices (deriving, compiling), one line
     assert rc == 1 and out == "" and all(ln.startswith(("gyro: deriving", "gyro: compiling")) for ln in lines[:-1])
     assert "cannot be solved for the dependent ones q2" in lines[-1] and "`reduced`" in lines[-1], err
+
+
+def test_coulomb_friction_at_rest_has_no_operator_and_says_which_term(tmp_path):
+    """A block with Coulomb friction mu m g sign(x') about rest: the operator does not exist
+    (derive/nonsmooth.py emits it NaN and names the term); gyro frequencies refuses in one
+    line naming sign(x_d) (it was LAPACK's 'qr failed to converge'); the belt's friction
+    sign(x_d - v) is linearised where v != 0 and a sweep through v = 0 fails that point only."""
+    from tests.conftest import ROOT, error_lines, run_cli
+
+    src = tmp_path / "coulomb_block.py"
+    src.write_text(
+        "import sympy as sp\nfrom derive.model import Model, Parameter\n\n\ndef build():\n"
+        "    x, x_d, x_dd = sp.symbols('x x_d x_dd')\n    m, k, mu, g = sp.symbols('m k mu g')\n"
+        "    return Model(name='coulomb_block', title='Coulomb block', source='test', module=__name__,\n"
+        "                 parameters=[Parameter('m', 'kg', 1.0, 'mass'), Parameter('k', 'N/m', 4.0, 'spring'),\n"
+        "                             Parameter('mu', '1', 0.3, 'friction', kind='nonnegative'),\n"
+        "                             Parameter('g', 'm/s^2', 9.81, 'gravity')],\n"
+        "                 coordinates=['x'], coordinate_units={'x': 'm'}, q=[x], qd=[x_d], qdd=[x_dd],\n"
+        "                 lagrangian=m * x_d**2 / 2 - k * x**2 / 2, generalized_forces={'x': -mu * m * g * sp.sign(x_d)})\n")
+    rc, out, err = run_cli("frequencies", str(src))
+    assert rc == 1 and out == "" and len(error_lines(err)) == 1, err
+    assert "no linear operator at this set" in err and "sign(x_d), its argument there 0" in err
+    belt = str(ROOT / "tests" / "models" / "belt_friction.py")
+    rc, out, err = run_cli("sweep", belt, "--x", "v", "--x-range", "-0.5", "0.5", "--points", "3", "--json")
+    doc = json.loads(out)
+    assert rc == 1 and doc["stability"] == ["stable", "failed", "stable"]
+    assert abs(doc["frequencies"][2][0] - np.sqrt(44.0)) < 1e-13 * np.sqrt(44.0)  # k + k_s past the stop

@@ -73,6 +73,9 @@ def test_two_multipliers_and_the_augmented_equations_are_lagranges_methods(chain
         pt = {sp.Symbol(s): sp.Rational(rng.randint(300, 1500), 1000) for s in names}
         _close(_num(ours[:n, :], pt), _num(eom, pt))
         _close(_num(ours[n:, :], pt), _num(_plain(lm.mass_matrix_full[2 * n:, n:] * unknowns - lm.forcing_full[2 * n:, :], q), pt))
+        # SymPy's mass_matrix writes the multipliers' columns with the opposite sign of its eom's
+        _close(_num(d.mass_matrix[:n, n:], pt), _num(-_plain(lm.mass_matrix[:, n:], q), pt))
+        _close(_num(d.mass_matrix[:n, :n], pt), _num(_plain(lm.mass_matrix[:, :n], q), pt))
 
 
 def test_operator_in_the_crank_angle_is_linearizes(chain):

@@ -146,8 +146,11 @@ def chart(rec: dict, path: Path) -> None:
             ax.plot(*zip(*pts), style, color=color, label=label + (f" (N^{k:.2f})" if k else ""))
     ax.set_xscale("log")
     ax.set_yscale("log")
+    from matplotlib.ticker import NullFormatter
+
     ax.set_xticks(list(NS))
     ax.set_xticklabels([str(n) for n in NS])
+    ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_xlabel("links N")
     ax.set_ylabel("time, s (one core)")
     ax.set_title("N-link pendulum on a cart: derivation against sympy.physics.mechanics")
@@ -162,7 +165,11 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, nargs="*", default=list(NS), help="the chain lengths N")
     ap.add_argument("--timeout", type=float, default=600.0, help="seconds per child process")
+    ap.add_argument("--chart-only", action="store_true", help="draw the chart again from the committed JSON")
     args = ap.parse_args(argv)
+    if args.chart_only:
+        chart(json.loads((RESULTS / "pendulum_chain.json").read_text()), RESULTS / "pendulum_chain.png")
+        return
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for n in args.n:

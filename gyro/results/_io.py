@@ -8,6 +8,23 @@ from pathlib import Path
 
 import numpy as np
 
+class Result:
+    """What every result of a batch or a set offers beside its own to_dict, table and plot:
+    save(path), every field into one .npz written atomically, and load(path), the same
+    fields back (the one place of both; `_loaded` rebuilds what JSON cannot carry)."""
+
+    def save(self, path) -> None:
+        _save_npz(self, path)
+
+    @classmethod
+    def load(cls, path):
+        return cls._loaded(_load_npz(cls, path))
+
+    @classmethod
+    def _loaded(cls, obj):
+        return obj
+
+
 def _save_npz(obj, path) -> None:
     """Every field of a dataclass of arrays and scalars into one .npz (objects as JSON)."""
     data = {}
@@ -29,14 +46,46 @@ def _save_npz(obj, path) -> None:
 
 
 def _load_npz(cls, path):
+    hints = _hints(cls)
     with np.load(path, allow_pickle=False) as z:
         kw = {}
         for f in fields(cls):
             if f.name not in z:
                 continue
             v = z[f.name]
-            kw[f.name] = json.loads(v.item()) if v.dtype.kind == "U" else v
+            kw[f.name] = _rebuild(hints.get(f.name), json.loads(v.item())) if v.dtype.kind == "U" else v
     return cls(**kw)
+
+
+def _hints(cls) -> dict:
+    import typing
+
+    try:
+        return typing.get_type_hints(cls)
+    except Exception:  # an annotation that does not resolve: fields load as JSON gives them
+        return {}
+
+
+def _rebuild(tp, value):
+    """A field saved as JSON back in its declared type: a nested result (a dataclass, e.g.
+    a sweep's Spectrum) field by field, an array from its list (complex from re/im)."""
+    import typing
+
+    if value is None or tp is None:
+        return value
+    args = [a for a in typing.get_args(tp) if a is not type(None)]
+    if typing.get_origin(tp) in (typing.Union, getattr(__import__("types"), "UnionType", typing.Union)) and args:
+        tp = args[0]
+    if is_dataclass(tp) and isinstance(value, dict):
+        hints = _hints(tp)
+        names = {f.name for f in fields(tp)}
+        return tp(**{k: _rebuild(hints.get(k), v) for k, v in value.items() if k in names})
+    if tp is np.ndarray:
+        if isinstance(value, dict) and set(value) == {"re", "im"}:
+            return np.asarray(value["re"]) + 1j * np.asarray(value["im"])
+        arr = np.asarray(value)
+        return arr if arr.dtype != object or not arr.size else np.array(value, dtype=object)
+    return value
 
 
 

@@ -5,7 +5,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from gyro.results._io import _pyplot, _save_npz, save_figure
+from gyro.results._io import Result, _pyplot, save_figure
 from gyro.results.spectrum import Spectrum, Stability, classify, nearest_error
 
 FORMULA_BAD = 0.01  # a formula errs by more than 1 %: shaded in the Campbell diagram
@@ -28,7 +28,7 @@ class Crossing:
 
 
 @dataclass
-class CampbellDiagram:
+class CampbellDiagram(Result):
     """Frequencies against the spin rate (Omega: for the torsion gyrocompass omega_c = H/C of
     (2.4), the rotor's own rate): the exact operator (default method, `exact` ascending per
     point; `tracked` the same roots with each mode in its own column, followed by its
@@ -282,9 +282,6 @@ class CampbellDiagram:
                        label="critical speeds (crossings)")
         if self.harmonics:
             ax.plot([], [], color="tab:orange", lw=1.0, ls="--", label="k x spin rate")
-
-    def save(self, path) -> None:
-        _save_npz(self, path)
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:

@@ -6,12 +6,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gyro.results._io import (_edges, _load_npz, _more_rows, _pyplot, _save_npz, _shown_rows,
-                               save_figure)
+from gyro.results._io import Result, _edges, _more_rows, _pyplot, _shown_rows, save_figure
 
 
 @dataclass
-class EquilibriumStability:
+class EquilibriumStability(Result):
     """The relative equilibrium of one parameter set: its conditions (margins, > 0 when
     satisfied), whether the sufficient one holds, and the spectrum of the linearisation."""
 
@@ -83,19 +82,16 @@ class EquilibriumStability:
                      f"spectrally stable: {'yes' if self.spectrally_stable else 'no'}; {verdict}")
         return "\n".join(lines)
 
-    def save(self, path) -> None:
-        _save_npz(self, path)
 
     @classmethod
-    def load(cls, path) -> "EquilibriumStability":
-        s = _load_npz(cls, path)
+    def _loaded(cls, s) -> "EquilibriumStability":
         s.eigenvalues = np.asarray(s.eigenvalues, float)
         s.radii = None if s.radii is None else np.asarray(s.radii, float)
         return s
 
 
 @dataclass
-class ConditionMap:
+class ConditionMap(Result):
     """Over a grid of two axes (arrays (y, x)): 2 where the sufficient condition ((3.6), or
     (4.3) on the orbit) holds, 1 where the linearisation is spectrally stable outside it
     (gyroscopic stabilisation), 0 where it is unstable."""
@@ -151,12 +147,9 @@ class ConditionMap:
                 f"{c['gyroscopic']} spectrally stable outside it, {c['unstable']} unstable, "
                 f"{c['boundary']} within rounding of a boundary{extra})")
 
-    def save(self, path) -> None:
-        _save_npz(self, path)
 
     @classmethod
-    def load(cls, path) -> "ConditionMap":
-        m = _load_npz(cls, path)
+    def _loaded(cls, m) -> "ConditionMap":
         m.values = np.asarray(m.values, int)
         m.boundary = np.asarray(m.boundary, bool)
         m.reasons = None if m.reasons is None else np.array(m.reasons, dtype=object)
@@ -190,7 +183,7 @@ class ConditionMap:
 
 
 @dataclass
-class AngleTrajectory:
+class AngleTrajectory(Result):
     """A motion in the model's coordinates (the gyrohorizoncompass's alpha, beta, gamma,
     epsilon) at the times t, with the integral E along it."""
 
@@ -227,12 +220,9 @@ class AngleTrajectory:
             lines.append(f"{t[i]:>12.6g}" + "".join(f"{v:>18.11g}" for v in q[i]))
         return "\n".join(lines + _more_rows(len(t)))
 
-    def save(self, path) -> None:
-        _save_npz(self, path)
 
     @classmethod
-    def load(cls, path) -> "AngleTrajectory":
-        tr = _load_npz(cls, path)
+    def _loaded(cls, tr) -> "AngleTrajectory":
         tr.coordinates = tuple(tr.coordinates)
         return tr
 

@@ -8,7 +8,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from gyro.results._io import _finite_or_none, _load_npz, _pyplot, _save_npz, save_figure
+from gyro.results._io import Result, _finite_or_none, _pyplot, save_figure
 
 
 class _Amplitudes:
@@ -31,7 +31,7 @@ class _Amplitudes:
 
 
 @dataclass
-class HarmonicResponse(_Amplitudes):
+class HarmonicResponse(_Amplitudes, Result):
     """x(t) = Re(X e^{i omega t}) about the equilibrium for the inputs w(t) = Re(u e^{i omega t}),
     one row per parameter set. `resonance` marks sets driven at a natural frequency of an
     undamped model (X inf); NaN rows had no equilibrium."""
@@ -111,16 +111,9 @@ class HarmonicResponse(_Amplitudes):
         save_figure(fig, out)
         plt.close(fig)
 
-    def save(self, path) -> None:
-        _save_npz(self, path)
-
-    @classmethod
-    def load(cls, path) -> "HarmonicResponse":
-        return _load_npz(cls, path)
-
 
 @dataclass
-class ForcedResponse(_Amplitudes):
+class ForcedResponse(_Amplitudes, Result):
     """The steady response of the torsion gyrocompass to harmonics of its bearing
     imperfections f_s = a sin(k gamma3 + phi), gamma3 = omega_c t (1.11), each kept apart:
     arrays (sets, harmonics, ...). x_j(t) = amplitudes_j sin(k omega_c t + phases_j) about
@@ -248,9 +241,4 @@ class ForcedResponse(_Amplitudes):
         save_figure(fig, out)
         plt.close(fig)
 
-    def save(self, path) -> None:
-        _save_npz(self, path)
 
-    @classmethod
-    def load(cls, path) -> "ForcedResponse":
-        return _load_npz(cls, path)

@@ -5,11 +5,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gyro.results._io import _edges, _finite_or_none, _load_npz, _pyplot, _save_npz, save_figure
+from gyro.results._io import Result, _edges, _finite_or_none, _pyplot, save_figure
 
 
 @dataclass
-class LevelMap:
+class LevelMap(Result):
     """values[i, j]: the relative error of `level` against `against` at y[i], x[j] (what the
     error measures: `measure`); NaN where it could not be computed (then `failed` says why)."""
 
@@ -53,12 +53,6 @@ class LevelMap:
             lines.append(f"{yv:>22.6g} " + " ".join(f"{v:>10.3g}" for v in self.values[i]))
         return "\n".join(lines)
 
-    def save(self, path) -> None:
-        _save_npz(self, path)
-
-    @classmethod
-    def load(cls, path) -> "LevelMap":
-        return _load_npz(cls, path)
 
     def plot(self, out) -> None:
         """log10 of the error as colour, the contour at tol as a thick line (where the level

@@ -5,11 +5,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gyro.results._io import _load_npz, _more_rows, _pyplot, _save_npz, _shown_rows, save_figure
+from gyro.results._io import Result, _more_rows, _pyplot, _shown_rows, save_figure
 
 
 @dataclass
-class ImagePointMotion:
+class ImagePointMotion(Result):
     """The image point x, y (22) and the gimbal angles alpha, beta (rad) at the times t, and
     the rotor momentum H (N m s), computed by one level (`full`, `rigorous`, `image`,
     `small`, `elementary`). `params` are the parameter values by their command-line names."""
@@ -50,12 +50,6 @@ class ImagePointMotion:
                          f"{self.beta[i]:>16.10g} {self.H[i]:>14.9g}")
         return "\n".join(lines + _more_rows(len(self.t)))
 
-    def save(self, path) -> None:
-        _save_npz(self, path)
-
-    @classmethod
-    def load(cls, path) -> "ImagePointMotion":
-        return _load_npz(cls, path)
 
     def plot(self, out) -> None:
         """The image point's path in the picture plane, and x, y against t; written whole or

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gyro.results._io import _pyplot, _save_npz, mode_panels, save_figure
+from gyro.results._io import Result, _pyplot, mode_panels, save_figure
 from gyro.results.spectrum import Spectrum
 
 
@@ -14,7 +14,7 @@ def _numbers(a) -> list:
 
 
 @dataclass
-class Sensitivities:
+class Sensitivities(Result):
     """d omega_i / d p_j over a batch: `d` (sets, modes, parameters) in rad/s per unit of
     the parameter (phi: per degree), NaN where `double` (sets, modes) says the root is
     double or nearly double (no derivative) or could not be computed."""
@@ -84,5 +84,3 @@ class Sensitivities:
         save_figure(fig, out)
         plt.close(fig)
 
-    def save(self, path) -> None:
-        _save_npz(self, path)

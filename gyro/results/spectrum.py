@@ -8,11 +8,11 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from gyro.results import verdict
-from gyro.results._io import _load_npz, _pyplot, _save_npz
+from gyro.results._io import Result, _pyplot
 
 
 @dataclass
-class Spectrum:
+class Spectrum(Result):
     """The result of one frequency method over a batch: arrays of shape (sets, modes)."""
 
     method: str
@@ -130,12 +130,9 @@ class Spectrum:
         lines.append(f"equilibrium: {label}{note}")
         return "\n".join(lines)
 
-    def save(self, path) -> None:
-        _save_npz(self, path)
 
     @classmethod
-    def load(cls, path) -> "Spectrum":
-        s = _load_npz(cls, path)
+    def _loaded(cls, s) -> "Spectrum":
         if isinstance(s.route, list):
             s.route = np.array(s.route, dtype=object)
         return s

@@ -5,11 +5,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gyro.results._io import _edges, _load_npz, _pyplot, _save_npz, save_figure
+from gyro.results._io import Result, _edges, _pyplot, save_figure
 
 
 @dataclass
-class StabilityMap:
+class StabilityMap(Result):
     """Stability of the equilibrium over a grid of two parameters (arrays (y, x))."""
 
     model: str
@@ -80,12 +80,9 @@ class StabilityMap:
     def summary(self, out) -> str:
         return f"gyro: wrote {out} ({', '.join(f'{v} {k}' for k, v in self.counts().items())})"
 
-    def save(self, path) -> None:
-        _save_npz(self, path)
 
     @classmethod
-    def load(cls, path) -> "StabilityMap":
-        m = _load_npz(cls, path)
+    def _loaded(cls, m) -> "StabilityMap":
         m.label = np.array(m.label, dtype=object)
         m.reasons = None if m.reasons is None else np.array(m.reasons, dtype=object)
         return m

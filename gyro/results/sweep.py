@@ -5,12 +5,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gyro.results._io import _finite_or_none, _pyplot, _save_npz, save_figure
+from gyro.results._io import Result, _finite_or_none, _pyplot, save_figure
 from gyro.results.spectrum import Spectrum, classify
 
 
 @dataclass
-class FrequencySweep:
+class FrequencySweep(Result):
     """Natural frequencies against one parameter (a Campbell diagram over any parameter)."""
 
     model: str
@@ -70,9 +70,6 @@ class FrequencySweep:
         ax.legend(fontsize=8)
         save_figure(fig, out)
         plt.close(fig)
-
-    def save(self, path) -> None:
-        _save_npz(self, path)
 
 
 # --------------------------------------------------------------------------- gyrohorizoncompass

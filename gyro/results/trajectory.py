@@ -5,11 +5,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gyro.results._io import _load_npz, _more_rows, _pyplot, _save_npz, _shown_rows, save_figure
+from gyro.results._io import Result, _more_rows, _pyplot, _shown_rows, save_figure
 
 
 @dataclass
-class Trajectory:
+class Trajectory(Result):
     """A motion of the gimbal gyroscope: theta, psi, phi at the times t, the method, the
     integrals at t = 0 and, from the closed form, the motion type and the period of theta."""
 
@@ -44,12 +44,6 @@ class Trajectory:
             lines.append(f"{t[i]:>14.6g} {self.theta[i]:>18.12g} {self.psi[i]:>18.12g} {self.phi[i]:>18.12g}")
         return "\n".join(lines + _more_rows(len(t)))
 
-    def save(self, path) -> None:
-        _save_npz(self, path)
-
-    @classmethod
-    def load(cls, path) -> "Trajectory":
-        return _load_npz(cls, path)
 
     def plot(self, out) -> None:
         """theta, psi, phi against t, written whole or not at all."""
@@ -66,7 +60,7 @@ class Trajectory:
 
 
 @dataclass
-class CoordinateMotion:
+class CoordinateMotion(Result):
     """A motion of any model from its reference (gyro/analyses/motion.py): every coordinate
     and its rate at the times t, in the model's units, by one integrator."""
 
@@ -106,12 +100,6 @@ class CoordinateMotion:
             lines.append(f"{self.t[i]:>12.6g}" + "".join(f"{x:>16.9g}" for x in self.q[i]))
         return "\n".join(lines + _more_rows(len(self.t)))
 
-    def save(self, path) -> None:
-        _save_npz(self, path)
-
-    @classmethod
-    def load(cls, path) -> "CoordinateMotion":
-        return _load_npz(cls, path)
 
     def plot(self, out) -> None:
         """Each coordinate against t, written whole or not at all."""

@@ -26,8 +26,6 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    import numpy as np
-
     from gyro import ladder
 
     model = model_with_equilibrium(args.model)
@@ -37,8 +35,7 @@ def run(args) -> int:
     if args.modes and args.method == "formulas":
         raise ParameterError("--modes: the formulas give frequencies only; use another --method")
     spec = ladder.spectrum(model, model.vector(values), args.method, modes=args.modes)
-    if not (np.all(np.isfinite(spec.frequencies[0])) and np.all(np.isfinite(spec.growth[0]))):
-        raise FloatingPointError("a frequency is not finite")  # no verdict: exit 1, text and JSON alike
+    ladder.require_finite(model, spec)  # no verdict: exit 1, text and JSON alike
     sens = None
     if getattr(args, "sensitivities", False):
         if args.method == "formulas":

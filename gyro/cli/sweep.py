@@ -34,6 +34,7 @@ def run(args) -> int:
     import numpy as np
 
     from gyro.analyses.sweep import sweep
+    from gyro.results._io import cell
 
     model = model_with_equilibrium(args.model)
     values = model.parameters(parse_sets(args.set))
@@ -53,6 +54,10 @@ def run(args) -> int:
     out = check_png_out(args.out) if args.out else None
     result = sweep(model, values, args.x, lo, hi, args.points, args.method, args.x_log,
                    progress=not args.quiet and sys.stderr.isatty(), scheduler=args.scheduler)
+    if not np.any(np.all(np.isfinite(result.spectrum.frequencies), axis=1)):  # no table of nothing: one line
+        from gyro.ladder import require_finite
+
+        require_finite(model, result.spectrum, f"any {args.x} of the sweep")
     if out is not None:
         result.plot(out)
     if args.json:
@@ -63,8 +68,8 @@ def run(args) -> int:
         f = result.spectrum.frequencies
         print(f"{'':>4} {args.x + ' [' + result.xunit + ']':>16} " + " ".join(f"{'omega' + str(j + 1):>12}" for j in range(f.shape[1])))
         for i, xv in enumerate(result.x):
-            print(f"{i + 1:>4} {xv:>16.8g} " + " ".join(f"{w:>12.6g}" for w in f[i]))
+            print(f"{i + 1:>4} {xv:>16.8g} " + " ".join(cell(w, ">12.6g") for w in f[i]))
     if not np.all(np.isfinite(result.spectrum.frequencies)):
-        print("gyro: some values have no finite spectrum (NaN above)", file=sys.stderr)
+        print("gyro: some values have no finite spectrum (none above)", file=sys.stderr)
         return 1
     return 0

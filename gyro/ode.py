@@ -29,6 +29,35 @@ class Symbolic:
     ydot: object
 
 
+# CasADi integrator options that keep SUNDIALS' own lines and CasADi's warnings on a NaN
+# of the right-hand side (a horizon near 1e308) off stderr: the error raised says it
+CASADI_QUIET = {"disable_internal_warnings": True, "show_eval_warnings": False}
+
+
+class stderr_silenced:
+    """File descriptor 2 to /dev/null while a compiled library runs (SUNDIALS' IDAS prints
+    its error lines there whatever the options); the exception it raises says what failed,
+    in the command's one line. Python's own sys.stderr is flushed first."""
+
+    def __enter__(self):
+        import os
+        import sys
+
+        sys.stderr.flush()
+        self.saved = os.dup(2)
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, 2)
+        os.close(null)
+        return self
+
+    def __exit__(self, *exc):
+        import os
+
+        os.dup2(self.saved, 2)
+        os.close(self.saved)
+        return False
+
+
 def _key(model: Model, what: str):
     return (what, model.name, str(getattr(model, "directory", "")), id(model))
 

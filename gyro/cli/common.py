@@ -150,15 +150,16 @@ def writable_folder(flag: str, path, folder: Path) -> None:
         raise ParameterError(f"{flag} {str(path)!r}: cannot write in {folder} ({exc.strerror or exc})") from None
 
 
-def refuse_over_budget(flag: str, count: int, each: float, scheduler=None, what: str = "sets") -> None:
-    """Before anything runs: ParameterError naming `flag` when `count` items at no less than
-    `each` seconds apiece (a method's measured COST, compiled: the fastest there is) cannot
-    fit the command line's budget in this process. On a --scheduler the cluster is the
-    user's, and nothing is refused here."""
+def refuse_over_budget(flag: str, count: int, each: float, scheduler=None, what: str = "sets",
+                       cluster: bool = True) -> None:
+    """Before anything runs: ParameterError naming `flag` when `count` items at `each`
+    seconds apiece (measured: a method's COST, compiled) cannot fit the command line's
+    budget in this process. On a --scheduler the cluster is the user's, and nothing is
+    refused here."""
     if scheduler is None and count * each > COMMAND_BUDGET:
-        raise ParameterError(f"{flag}: {count} {what} take at least {count * each:.0f} s in this process "
+        raise ParameterError(f"{flag}: {count} {what} take about {count * each:.0f} s in this process "
                              f"({each * 1e6:.3g} us each), over the command line's budget of "
-                             f"{COMMAND_BUDGET:.0f} s: ask for fewer, or use --scheduler")
+                             f"{COMMAND_BUDGET:.0f} s: ask for fewer" + (", or use --scheduler" if cluster else ""))
 
 
 def method_cost(name: str) -> float:

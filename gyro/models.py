@@ -317,19 +317,31 @@ def _why(path: Path, root: Path) -> str:
 
 
 class _Notice:
-    """The one line said while a model file is derived: on a terminal a line of its own,
-    erased when the derivation fails (the error is then the one line left); elsewhere the
-    line as it is, a one-off notice before the command's own output (a failure is cached,
-    so the next call says its one line only)."""
+    """The one line said while a model file is derived: on a terminal at once, erased when
+    the derivation fails (the error is then the one line left); elsewhere only once the
+    derivation has taken NOTICE_AFTER seconds (a file that is no model fails within about
+    one: its line is then the only one), a one-off notice before the command's own output.
+    A failure is cached, so the next call says its one line only."""
+
+    NOTICE_AFTER = 2.0  # s
 
     def __init__(self, text: str):
         import sys
+        import threading
 
-        self.tty = sys.stderr.isatty()
-        print(text + (" ..." if self.tty else ""), end="" if self.tty else "\n", file=sys.stderr, flush=True)
+        self.tty, self.timer = sys.stderr.isatty(), None
+        if self.tty:
+            print(text + " ...", end="", file=sys.stderr, flush=True)
+        else:
+            stream = sys.stderr  # the stream of the caller's moment (a session may swap it after)
+            self.timer = threading.Timer(self.NOTICE_AFTER, lambda: print(text, file=stream, flush=True))
+            self.timer.daemon = True
+            self.timer.start()
 
     def end(self, failed: bool) -> None:
         import sys
 
-        if self.tty:
+        if self.timer is not None:
+            self.timer.cancel()
+        elif self.tty:
             print("\r\033[K" if failed else "", file=sys.stderr, end="" if failed else "\n", flush=True)

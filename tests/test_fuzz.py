@@ -359,6 +359,7 @@ def issue_lines(tmp):
         yield ["simulate", "gimbal_gyroscope", "--t-end", "0.1", "--points", "3", "--out", out]
         yield ["map", "gyrohorizoncompass", "--x", "zeta=0.05:0.8:2", "--y", "eta=-0.5:0.5:2", "--out", out]
     yield ["forced", *tg, "--harmonic", "1:1:1", "--set", "Kp=1e300"]
+    yield unb[:7] + ["1e300", "--spin-range", "0", "1e300", "--points", "3", "--quiet"]
     yield ["sweep", "gimbal_precession", "--x", "k_xi1", "--x-range", "0", "1e-4", "--points", "3"]
     yield ["tolerance", "gimbal_precession", "--spread", "l_x=normal:0.05", "--samples", "10", "--quiet"]
     yield tol + ["--samples", "10", "--correlate", "Kp,K0=0.5", "--correlate", "K0,Kp=-0.5"]
@@ -446,6 +447,7 @@ def _holds(argv, code, out, err, dt, tmp, scratch):
     if code:
         assert len(err.strip().splitlines()) == 1 and err.startswith(("gyro", "usage")), f"{where}: {err!r}"
         assert "np.float64" not in err and "__init__.py" not in err, f"{where}: {err!r}"
+        assert not err.startswith(("gyro: error: omega:", "gyro: error: u:")), f"{where}: an internal name: {err!r}"
     if code == 2:
         assert out == "", f"{where}: stdout on bad input: {out[:200]!r}"
     if code == 0 and "--json" not in argv:

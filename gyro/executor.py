@@ -105,8 +105,12 @@ def client(scheduler):
     if isinstance(scheduler, Client):
         return scheduler
     if scheduler == "local":
+        import logging
+
+        # the workers' own log lines (ports, memory, a worker restarted) are not the command's
+        # output: its one line says what failed (silence_logs is the level shown, WARN by default)
         cluster = LocalCluster(n_workers=max(1, os.cpu_count() or 1), threads_per_worker=1, processes=True,
-                               dashboard_address=None)
+                               dashboard_address=None, silence_logs=logging.CRITICAL)
         return Client(cluster)
     try:
         return Client(scheduler, timeout="10s")

@@ -365,6 +365,7 @@ def issue_lines(tmp):
     yield tol + ["--samples", "10", "--correlate", "Kp,K0=0.5", "--correlate", "K0,Kp=-0.5"]
     yield tol + ["--samples", "10", "--correlate", "Kp,K0=0.5", "--correlate", "Kp,K0=0.5"]
     yield tol + ["--samples", "1"]
+    yield tol + ["--samples", "10", "--store", "/proc/gyro-fuzz/store"]
     yield tol + ["--samples", "10000000"]
     yield tol + ["--samples", "1000000000"]
     yield ["frequencies", *tg, "--set", "A=1e-300"]

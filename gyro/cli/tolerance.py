@@ -8,7 +8,8 @@ import json
 import sys
 
 from gyro.cli.common import (add_json, add_model, add_out, add_quiet, add_scheduler, add_set, check_png_out,
-                             method_cost, model_with_equilibrium, parse_sets, refuse_over_budget)
+                             method_cost, model_with_equilibrium, parse_sets, refuse_over_budget,
+                             writable_folder)
 from gyro.errors import ParameterError
 
 ORDER = 37
@@ -90,6 +91,11 @@ def run(args) -> int:
     store = Path(args.store) if args.store else None
     if store is not None and store.exists() and not store.is_dir():
         raise ParameterError(f"--store {args.store!r}: not a folder")
+    if store is not None:  # tried before sampling: the folder, or the nearest one it will be made in
+        where = store.resolve()
+        while not where.is_dir() and where != where.parent:
+            where = where.parent
+        writable_folder("--store", args.store, where)
     study = tolerance(model, values, spreads, args.samples, args.seed, parse_pairs(args.correlate),
                       args.scheduler, parse_harmonics(args.harmonics), args.band, store,
                       progress=not args.quiet and sys.stderr.isatty())

@@ -194,13 +194,11 @@ def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: i
     S = sens.d[0][:, index]
     first_std = np.sqrt(np.einsum("ij,jk,ik->i", S, cov, S))
     nmodes = nomspec.frequencies.shape[1]
-    folder = store
-    tmp = None
-    if folder is None and n * (nmodes + 1) * 8 > IN_MEMORY:
-        tmp = tempfile.TemporaryDirectory(prefix="gyro-tolerance-")
-        folder = Path(tmp.name)
-    out = F = None
-    try:
+    folder, tmp, out, F = store, None, None, None
+    try:  # the temporary folder made inside: a signal at any moment after finds it to remove
+        if folder is None and n * (nmodes + 1) * 8 > IN_MEMORY:
+            tmp = tempfile.TemporaryDirectory(prefix="gyro-tolerance-")
+            folder = Path(tmp.name)
         ref = model_ref(model)
         out = executor.run(chunk, n, size, (ref, nominal, index, relwidth, uniform, chol, seed), scheduler,
                            folder, progress, "tolerance", warm=warm, warm_args=(ref,))

@@ -375,6 +375,8 @@ def issue_lines(tmp):
     yield ["scene", "gimbal_gyroscope", "motion", "--tol", "1e-3", "--horizon", "1e6"]
     yield ["scene", "gyrohorizoncompass", "motion", "--tol", "1e-3", "--horizon", "1e6"]
     yield ["map", "gyrohorizoncompass", "--x", "nu=1e-4:1e-3:1000", "--y", "eta=0:0.1:1000", "--out", png]
+    yield ["level-map", "gimbal_precession", "--level", "small", "--against", "full", "--x", "k_xi1=0:1e-4:100",
+           "--y", "l_x=5e-4:1e-3:100", "--out", png]
     for method in ("cvodes", "idas"):
         yield ["simulate", "gimbal_gyroscope", "--method", method, "--t-end", "1e308", "--points", "5"]
 

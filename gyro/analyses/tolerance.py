@@ -29,7 +29,7 @@ import numpy as np
 
 from gyro import executor, ladder
 from gyro.analyses.sweep import model_ref, warm
-from gyro.errors import ParameterError
+from gyro.errors import ParameterError, terminable
 from gyro.models import Model, load
 from gyro.results import ToleranceStudy
 
@@ -195,25 +195,26 @@ def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: i
     first_std = np.sqrt(np.einsum("ij,jk,ik->i", S, cov, S))
     nmodes = nomspec.frequencies.shape[1]
     folder, tmp, out, F = store, None, None, None
-    try:  # the temporary folder made inside: a signal at any moment after finds it to remove
-        if folder is None and n * (nmodes + 1) * 8 > IN_MEMORY:
-            tmp = tempfile.TemporaryDirectory(prefix="gyro-tolerance-")
-            folder = Path(tmp.name)
-        ref = model_ref(model)
-        out = executor.run(chunk, n, size, (ref, nominal, index, relwidth, uniform, chol, seed), scheduler,
-                           folder, progress, "tolerance", warm=warm, warm_args=(ref,))
-        F = out["frequencies"]
-        ok = np.all(np.isfinite(F), axis=1)
-        stats = _stats(F, ok)
-        bands = None
-        if harmonics:
-            spin = out["spin"]
-            bands = _bands(F, ok, spin, harmonics, band, nomspec.frequencies[0], sens.d[0], model, nominal, cov,
-                           index)
-    finally:  # also on Ctrl-C, SIGTERM (the command line raises it here) and MemoryError
-        if tmp is not None:
-            out = F = None  # the memory maps closed before their folder goes
-            tmp.cleanup()
+    with terminable():  # SIGTERM as Ctrl-C here: the chunks return to Python often
+        try:  # the temporary folder made inside: Ctrl-C, SIGTERM or MemoryError after finds it
+            if folder is None and n * (nmodes + 1) * 8 > IN_MEMORY:
+                tmp = tempfile.TemporaryDirectory(prefix="gyro-tolerance-")
+                folder = Path(tmp.name)
+            ref = model_ref(model)
+            out = executor.run(chunk, n, size, (ref, nominal, index, relwidth, uniform, chol, seed), scheduler,
+                               folder, progress, "tolerance", warm=warm, warm_args=(ref,))
+            F = out["frequencies"]
+            ok = np.all(np.isfinite(F), axis=1)
+            stats = _stats(F, ok)
+            bands = None
+            if harmonics:
+                spin = out["spin"]
+                bands = _bands(F, ok, spin, harmonics, band, nomspec.frequencies[0], sens.d[0], model, nominal, cov,
+                               index)
+        finally:
+            if tmp is not None:
+                out = F = None  # the memory maps closed before their folder goes
+                tmp.cleanup()
     return ToleranceStudy(model.name, model.meta["title"], n, seed, [s.__dict__ for s in spreads],
                           {f"{a},{b}": r for (a, b), r in (pairs or {}).items()},
                           nomspec.frequencies[0], sens, index, first_std, int(np.sum(~ok)), *stats,

@@ -26,7 +26,7 @@ import pkgutil
 import sys
 
 from gyro.cli.common import COMMAND_BUDGET, EXIT_USAGE, Parser
-from gyro.errors import ParameterError
+from gyro.errors import ParameterError, Terminated
 
 
 def commands() -> list:
@@ -72,7 +72,7 @@ def main(argv=None) -> int:
     from gyro.equilibrium import EquilibriumError
 
     try:
-        with np.errstate(all="ignore"), _stdout_for_results_only(), _terminated_as_interrupt(), _quiet_libraries(), \
+        with np.errstate(all="ignore"), _stdout_for_results_only(), _quiet_libraries(), \
                 executor.budget(COMMAND_BUDGET):
             return args.run(args)  # failures: one line each
     except Terminated:
@@ -115,35 +115,6 @@ def _interrupted() -> int:
 
 
 EXIT_TERMINATED = 143  # 128 + SIGTERM, as a shell reports a process the signal ended
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised where the command is, so that its `finally` blocks run (temporary
-    folders, memory maps): the command stops as on Ctrl-C and leaves nothing behind."""
-
-
-class _terminated_as_interrupt:
-    """While a command runs (in the main thread), SIGTERM raises Terminated; the handler
-    before is restored after, so that a command run inside a session leaves none of its own."""
-
-    def __enter__(self):
-        import signal
-        import threading
-
-        self.saved = None
-        if threading.current_thread() is threading.main_thread():
-            def stop(signum, frame):
-                raise Terminated()
-
-            self.saved = signal.signal(signal.SIGTERM, stop)
-        return self
-
-    def __exit__(self, *exc):
-        import signal
-
-        if self.saved is not None:
-            signal.signal(signal.SIGTERM, self.saved)
-        return False
 
 
 class _quiet_libraries:

@@ -158,7 +158,8 @@ def refuse_over_budget(flag: str, count: int, each: float, scheduler=None, what:
     refused here."""
     if scheduler is None and count * each > COMMAND_BUDGET:
         raise ParameterError(f"{flag}: {count} {what} take about {count * each:.0f} s in this process "
-                             f"({each * 1e6:.3g} us each), over the command line's budget of "
+                             f"({f'{each:.3g} s' if each >= 0.01 else f'{each * 1e6:.3g} us'} each), over the "
+                             "command line's budget of "
                              f"{COMMAND_BUDGET:.0f} s: ask for fewer" + (", or use --scheduler" if cluster else ""))
 
 

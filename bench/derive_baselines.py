@@ -184,6 +184,8 @@ def points() -> dict:
     d = dict(m.defaults)
     for k in ("u_xi", "f_alpha", "f_beta", "f_phi", "Mmotor", "k_xi1", "l_y", "l_z", "m_x", "m_y", "m_z"):
         d[k] = float(rng.uniform(1e-4, 1e-3))  # every term of the equations present
+    d["C1"], d["C2"] = 0.5 * d["C3"], 1.5 * d["C3"]  # a flat ring: C2 - C1 = C3 enters,
+    d["u_eta"], d["u_zeta"] = 0.3, 0.7  # through (C2 - C1) times the base rate's eta1, zeta1 components
     P = m.vector(d)
     qv = rng.uniform(-1, 1, 3).tolist()
     qdv = rng.uniform(-2, 2, 3).tolist()
@@ -192,7 +194,8 @@ def points() -> dict:
         "point": {**d, "q": qv, "qd": qdv},
         "values": {"mass_matrix": m.numpy.mass_matrix(P, qv), "forcing": np.ravel(m.numpy.forcing(P, qv, qdv))},
         "where": "the defaults with the zero moments, frictions and u_xi drawn in [1e-4, 1e-3], "
-                 "at a random state (phi' = 900 rad/s)"}
+                 "a flat outer ring (C1 = C3/2, C2 = 3 C3/2) on a base turning at u_eta = 0.3, "
+                 "u_zeta = 0.7 rad/s, at a random state (phi' = 900 rad/s)"}
     return out
 
 

@@ -533,6 +533,49 @@ def speed(quick: bool) -> dict:
     }
 
 
+def random_speed(n: int, seed: int = 36) -> dict:
+    """The speed where it is used (issue 36): n random sets of the project's joint spread
+    (`joint`), one core, each request against the exact operator by the default method on
+    the same sets in the same run (chunks of 10,000 sets), with the levels picked; and what
+    the certificate costs: the counts of one and of ten modes on the formulas' answers."""
+    P = joint(n, seed)
+    chunk = 10_000
+    parts = [P[s:s + chunk] for s in range(0, n, chunk)]
+    for lv in hierarchy.levels(TG):  # warm every compiled path
+        if (lv.answers_question("frequencies") and lv.name != "linear_exact:reference"
+                and not lv.name.endswith("polyroots")):
+            F.answer(TG, lv, P[:2], {})
+
+    def timed(fn):
+        t0 = time.perf_counter()
+        out = [fn(p) for p in parts]
+        return (time.perf_counter() - t0) / n, out
+
+    t_exact, _ = timed(lambda p: ladder.spectrum(TG, p, "default"))
+    out = {"sets": n, "seed": seed, "exact_default_s_per_set": t_exact}
+    for key, tol, opts in (("all_1e-3", 1e-3, {}), ("modes_1_2_4_1e-3", 1e-3, {"modes": [1, 2, 4]}),
+                           ("modes_4_1e-3", 1e-3, {"modes": [4]}), ("all_1e-9", 1e-9, {})):
+        t, scenes_ = timed(lambda p: select(TG, "frequencies", p, tol, opts))
+        used = {}
+        for sc in scenes_:
+            for name, c in zip(*np.unique(sc.level, return_counts=True)):
+                used[str(name)] = used.get(str(name), 0) + int(c)
+        out[key] = {"s_per_set": t, "ratio_to_exact": t_exact / t, "levels": used}
+    # the certificate alone, on the formulas' answers of the first chunk
+    p = parts[0]
+    lv = hierarchy.get(TG, "formulas")
+    ans = F.answer(TG, lv, p, {})
+    b = np.full(ans.values.shape, 1e-3)
+    for key, idx in (("certificate_1_mode_s_per_set", [3]), ("certificate_10_modes_s_per_set", list(range(10)))):
+        t0 = time.perf_counter()
+        F.certify(TG, lv, p, ans, b, idx)
+        out[key] = (time.perf_counter() - t0) / p.shape[0]
+    t0 = time.perf_counter()
+    F.answer(TG, lv, p, {})
+    out["formulas_s_per_set"] = (time.perf_counter() - t0) / p.shape[0]
+    return out
+
+
 def rungs(quick: bool) -> dict:
     """How far above the cheapest level that was enough the selector goes: per tolerance,
     the sets whose chosen level is more than one rung (a level answering every frequency and
@@ -774,7 +817,16 @@ def main(argv=None) -> int:
                     help="only the torsion gyrocompass's motion map (levels.json 'torsion_motion_map')")
     ap.add_argument("--ghc-motion", action="store_true",
                     help="only the gyrohorizoncompass's motion levels (costs, error map), into levels.json")
+    ap.add_argument("--random-speed", type=int, metavar="N",
+                    help="only the speed over N random sets of the joint spread (levels.json 'random_speed')")
     args = ap.parse_args(argv)
+    if args.random_speed:
+        path = RESULTS / "levels.json"
+        out = json.loads(path.read_text()) if path.exists() else {}
+        out["random_speed"] = random_speed(args.random_speed)
+        path.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
+        print(json.dumps(out["random_speed"], indent=1))
+        return 0
     if args.torsion_motion:
         path = RESULTS / "levels.json"
         out = json.loads(path.read_text()) if path.exists() else {}

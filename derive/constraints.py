@@ -1,7 +1,8 @@
 """Holonomic constraints phi(q, t) = 0 (the model's `holonomic` field).
 
-Where the constraints can be solved for dependent coordinates with one solution (a
-rolling disc's y - R theta = 0: theta = y/R), they are eliminated symbolically: the
+Where the constraints are linear in some of the coordinates (a rolling disc's
+y - R theta = 0: theta = y/R), they are solved for those by one linear solve and eliminated
+symbolically: the
 dependent coordinates and their rates are substituted into the Lagrangian, the
 dissipation and the loads, a generalised force on a dependent coordinate is carried to
 the independent ones by virtual work (Q_i += Q_dep d q_dep / d q_i), and the model goes
@@ -37,6 +38,7 @@ from itertools import combinations
 import sympy as sp
 
 from derive import mechanics as mech
+from derive.derivation import Derivation
 from derive.model import TIME, Load, Model, Unsupported
 
 
@@ -56,21 +58,23 @@ def _constraints(model: Model) -> list:
 
 
 def solve_dependent(model: Model):
-    """(indices of the dependent coordinates, their solution) when the constraints have one
-    solution for some m coordinates (the last ones tried first), else None."""
+    """(indices of the dependent coordinates, their solution) where the constraints are
+    linear in some m coordinates with a Jacobian free of them and not identically singular
+    (the last ones tried first): one solution, by one linear solve, in bounded time. Else
+    None, and the constraints are carried by multipliers: a general nonlinear solve has no
+    bound on its work (a four-bar linkage's loop closure kept sympy.solve busy for over
+    900 s) and mostly several branches (x^2 + y^2 = L^2), which elimination cannot take."""
     phis = _constraints(model)
     q, m = list(model.q), len(phis)
+    Phi = sp.Matrix(phis)
     for deps in combinations(reversed(range(len(q))), m):
         dq = [q[i] for i in sorted(deps)]
-        if sp.Matrix(phis).jacobian(dq).det() == 0:
+        J = Phi.jacobian(dq)
+        if J.has(*dq) or sp.expand(J.det()) == 0:
             continue
-        try:
-            sols = sp.solve(phis, dq, dict=True)
-        except (NotImplementedError, ValueError):
-            continue
-        if len(sols) == 1 and all(d in sols[0] for d in dq) and not any(
-                sols[0][d].has(*dq) for d in dq):
-            return sorted(deps), {d: sols[0][d] for d in dq}
+        rest = Phi.xreplace({x: 0 for x in dq})
+        sol = (-J.LUsolve(rest)).applyfunc(sp.simplify)
+        return sorted(deps), dict(zip(dq, sol))
     return None
 
 
@@ -121,7 +125,6 @@ def eliminate(model: Model, deps: list, sol: dict) -> tuple[Model, dict]:
 
 def multipliers(model: Model, Q, steps):
     """The derivation with Lagrange multipliers (module docstring)."""
-    from derive.pipeline import Derivation  # the one result type
 
     phis = _constraints(model)
     m, n = len(phis), len(model.q)
@@ -169,10 +172,10 @@ def multipliers(model: Model, Q, steps):
         for j, phi in enumerate(phis):
             H += lam0[j] * sp.hessian(phi, q)
         E0 = E.subs({s: 0 for s in zero_inputs})
-        Mr = (C.T * E0.jacobian(qdd).subs(rest) * C).applyfunc(sp.simplify)
-        Dr = (C.T * E0.jacobian(qd).subs(rest) * C).applyfunc(sp.simplify)
-        Kr = (C.T * (E0.jacobian(q).subs(rest) + H) * C).applyfunc(sp.simplify)
-        residual = (C.T * f0).applyfunc(sp.simplify)
+        Mr = (C.T * E0.jacobian(qdd).subs(rest) * C)
+        Dr = (C.T * E0.jacobian(qd).subs(rest) * C)
+        Kr = (C.T * (E0.jacobian(q).subs(rest) + H) * C)
+        residual = (C.T * f0)
         op = mech.LinearOperator(Mr, Dr, Kr)
     rq = [q[i] for i in ind]
     d = Derivation(model=model, mass_matrix=Maug, forcing=faug, routhian=model.lagrangian, rq=rq,
@@ -182,7 +185,7 @@ def multipliers(model: Model, Q, steps):
     w = list(model.input_signal_symbols)
     if w:
         Bq = -E.jacobian(w).subs(rest)
-        B = (C.T * Bq).applyfunc(sp.simplify)
+        B = (C.T * Bq)
         keep = [j for j in range(len(w)) if any(B[i, j] != 0 for i in range(B.rows))]
         d.inputs = [w[j] for j in keep]
         d.input_matrix = B.extract(list(range(B.rows)), keep) if keep else None

@@ -4,9 +4,13 @@ coordinates, their rates and accelerations, with no assumptions.
 
 - Coordinates given as `dynamicsymbols('theta')`: theta(t) becomes the symbol `theta`, its
   derivative theta' the symbol `theta_d` and theta'' `theta_dd` (or whatever `qd`, `qdd`
-  name). `qd` and `qdd` may be left empty, or given as speeds `dynamicsymbols('u')`: a speed
-  of `qd` stands for the derivative of its coordinate (u_i = q_i'); the machinery derives
-  Lagrange's equations, whose speeds are the coordinates' rates.
+  name). `qd` and `qdd` may be left empty, or given as speeds `dynamicsymbols('u')`. With
+  kinematic equations (`kinematics`, KanesMethod's kd_eqs) a speed is what they say: every
+  u is replaced by its expression in q and q', and the record of q' = V u + v goes to the
+  derivation, which forms the equations in the speeds (pipeline.speeds_equations). Without
+  them a speed stands for its coordinate's derivative, and must be it in every velocity of
+  the model's frames and load points it enters; a speed that is not, or that enters none
+  the machinery can see, is refused (_check_rates), never guessed.
 - Any other function of time, F(t), is an input: the `Signal` of that name when the model
   declares one (its rungs F, F_d, ... for F, F', ...), else an input signal made here of
   the order the derivation needs, as sympy's linearize takes every such function as an
@@ -101,7 +105,7 @@ def _load(ld, frame, name: str) -> Load:
 def _dynamic_rates(model: Model):
     """(map of the coordinates' functions of time and their derivatives to symbols,
     coordinates, rates, accelerations)."""
-    mapping, q, qd, qdd = {}, [], [], []
+    mapping, q, qd, qdd, claimed = {}, [], [], [], []
     given_qd, given_qdd = list(model.qd), list(model.qdd)
     for i, x in enumerate(model.q):
         dyn = _is_dynamic(x)
@@ -116,6 +120,8 @@ def _dynamic_rates(model: Model):
         if isinstance(v, sp.Derivative) or _is_dynamic(v):  # q' itself, or a speed u = q'
             vs = sp.Symbol(f"{q[-1]}_d") if isinstance(v, sp.Derivative) else sp.Symbol(type(v).__name__)
             mapping[v] = vs
+            if dyn and _is_dynamic(v):  # a speed of its own, said to be the rate: checked
+                claimed.append((x, v))
             if dyn:
                 mapping[x.diff(TIME)] = vs
         else:
@@ -132,7 +138,138 @@ def _dynamic_rates(model: Model):
         else:
             asym = _plain(a)
         qdd.append(asym)
-    return mapping, q, qd, qdd
+    return mapping, q, qd, qdd, claimed
+
+
+def _kinematics(model: Model):
+    """The speeds of `kinematics` (KanesMethod's kd_eqs): (speeds u(t), {u(t): u as an
+    expression of q(t), q'(t)}, V, v with q' = V u + v), or None without kinematics. The
+    equations must be linear in the speeds and in q', n of them for n coordinates and n
+    speeds, solvable for either (refused in one line otherwise)."""
+    if not model.kinematics:
+        return None
+    name = model.name
+    us = list(model.qd)
+    if not all(_is_dynamic(x) for x in model.q) or not us or not all(_is_dynamic(u) for u in us):
+        raise Unsupported(f"{name}: kinematic equations take coordinates and speeds as dynamicsymbols "
+                          "(q(t) in `q`, u(t) in `qd`), as KanesMethod's kd_eqs do")
+    if len(us) != len(model.q) or len(model.kinematics) != len(us):
+        raise Unsupported(f"{name}: {len(model.kinematics)} kinematic equations for {len(model.q)} coordinates "
+                          f"and {len(us)} speeds: one per coordinate and speed")
+    qdots = [x.diff(TIME) for x in model.q]
+    kd = sp.Matrix([_expression(e, f"kinematic equation {k + 1}", name) for k, e in enumerate(model.kinematics)])
+    Wu, Wq = kd.jacobian(us), kd.jacobian(qdots)
+    for W, what in ((Wu, "the speeds"), (Wq, "the coordinates' derivatives")):
+        if W.has(*us) or W.has(*qdots):
+            raise Unsupported(f"{name}: the kinematic equations are not linear in {what}")
+    rest = kd.xreplace({**{u: 0 for u in us}, **{d: 0 for d in qdots}})
+    if any(e.has(sp.Derivative) for e in rest) or any(e.has(sp.Derivative) for e in Wu):
+        raise Unsupported(f"{name}: the kinematic equations have a derivative other than the coordinates' "
+                          "first derivatives")
+    import random
+
+    for W, what in ((Wu, "the speeds"), (Wq, "the coordinates' derivatives")):
+        if _numerically_zero([W.det(method="berkowitz")], random.Random(3)):  # at two random points
+            raise Unsupported(f"{name}: the kinematic equations cannot be solved for {what} (their "
+                              "Jacobian is singular): the speeds must be independent")
+    # the solutions as they come, not simplified (sp.simplify took 2.4 s of a top's 3.8 s)
+    solve_u = -Wu.LUsolve(Wq * sp.Matrix(qdots) + rest)
+    V, v = -Wq.LUsolve(Wu), -Wq.LUsolve(rest)
+    return us, dict(zip(us, solve_u)), V, v
+
+
+def _numerically_zero(exprs, rng) -> bool:
+    """Every expression (in functions of time, their derivatives and symbols) zero at two
+    random rational points, to 30 digits."""
+    exprs = [sp.sympify(e) for e in exprs]
+    for _ in range(2):
+        pt = {}
+        for e in exprs:
+            for d in e.atoms(sp.Derivative):
+                pt.setdefault(d, sp.Rational(rng.randint(-2000, 2000), 1000))
+        sub = [e.xreplace(pt) for e in exprs]
+        pt2 = {f: sp.Rational(rng.randint(-2000, 2000), 1000) for e in sub for f in e.atoms(AppliedUndef)}
+        sub = [e.xreplace(pt2) for e in sub]
+        pt3 = {s: sp.Rational(rng.randint(500, 2000), 1000) for e in sub for s in e.free_symbols}
+        if any(abs(complex(sp.N(e.xreplace(pt3), 30))) > 1e-20 for e in sub):
+            return False
+    return True
+
+
+def _frames_and_points(model: Model):
+    """The reference frames connected to the model's inertial frame by orientations or set
+    angular velocities, and the points of its loads with those connected to them by
+    positions or velocities."""
+    frames, todo = [], [model.frame] if model.frame is not None else []
+    while todo:
+        f = todo.pop()
+        if f is None or any(f is g for g in frames):
+            continue
+        frames.append(f)
+        todo += list(getattr(f, "_dcm_dict", {})) + list(getattr(f, "_ang_vel_dict", {}))
+    types = _vector_types()
+    points, todo = [], []
+    for ld in model.loads:
+        where = getattr(ld, "location", None) or getattr(ld, "point", None)
+        if where is None and isinstance(ld, tuple) and ld:
+            where = ld[0]
+        if types is not None and isinstance(where, types[1]):
+            todo.append(where)
+    while todo:
+        p = todo.pop()
+        if any(p is g for g in points):
+            continue
+        points.append(p)
+        todo += list(getattr(p, "_pos_dict", {}))
+    return frames, points
+
+
+def _check_rates(model: Model, claimed: list) -> None:
+    """Speeds given without kinematic equations, u(t) in `qd` for q(t), stand for q'(t):
+    each must be its coordinate's derivative in every velocity of the model's frames and
+    points that it enters (a set angular velocity against the one its orientation gives,
+    a set velocity against its neighbour's plus the derivative of the position between
+    them). A speed that is not, or that enters no velocity the machinery can check (the
+    Lagrangian is a scalar: it cannot tell u from q'), is refused in one line: kinematic
+    equations say what a speed is (Model.kinematics)."""
+    import random
+
+    rng = random.Random(0)
+    as_rate = {u: x.diff(TIME) for x, u in claimed}
+    seen: set = set()
+    fix = ("give the kinematic equations (kinematics=[q' - u, ...] or the body's, as KanesMethod's "
+           "kd_eqs), or write the coordinate's derivative itself")
+    frames, points = _frames_and_points(model)
+    checks = []
+    for f in frames:
+        for other, w in getattr(f, "_ang_vel_dict", {}).items():
+            if other in getattr(f, "_dcm_dict", {}) and f is not model.frame:  # each pair from its body's side
+                checks.append((w, lambda f=f, other=other: f._w_diff_dcm(other), other,
+                               f"the angular velocity of {f} in {other}"))
+    inertial = model.frame
+    for p in points:
+        vp = getattr(p, "_vel_dict", {}).get(inertial)
+        for o, r in getattr(p, "_pos_dict", {}).items():
+            vo = getattr(o, "_vel_dict", {}).get(inertial)
+            if vp is not None and vo is not None:
+                checks.append((vp, lambda vo=vo, r=r: vo + r.dt(inertial), inertial, f"the velocity of {p} in {inertial}"))
+    for w, implied, frame, what in checks:
+        inside = [u for u in as_rate if w.args and any(m.has(u) for m, _ in w.args)]
+        if not inside:
+            continue
+        diff = (w.subs(as_rate) - implied()).to_matrix(frame)
+        if not _numerically_zero(list(diff), rng):
+            u = inside[0]
+            x = next(x for x, v in claimed if v == u)
+            raise Unsupported(f"{model.name}: the speed {type(u).__name__} is not the rate of "
+                              f"{type(x).__name__} in {what}: {fix}")
+        seen.update(inside)
+    unchecked = [u for _, u in claimed if u not in seen]
+    if unchecked:
+        x = next(x for x, v in claimed if v == unchecked[0])
+        raise Unsupported(f"{model.name}: the speed {type(unchecked[0]).__name__} of {type(x).__name__} enters no "
+                          f"velocity of the model's frames or load points that shows it is {type(x).__name__}'s "
+                          f"rate: {fix}")
 
 
 def _exprs(model: Model, loads) -> list:
@@ -252,8 +389,16 @@ def convert(model: Model) -> Model:
 def _convert(model: Model) -> Model:
     loads = [ld if isinstance(ld, Load) and not (_is_vector(ld.vector) or _is_vector(ld.velocity))
              else _load(ld, model.frame, f"{model.name}: load {k + 1}") for k, ld in enumerate(model.loads)]
-    mapping, q, qd, qdd = _dynamic_rates(model)
-    exprs = _exprs(model, loads)
+    kin = _kinematics(model)
+    mapping, q, qd, qdd, claimed = _dynamic_rates(dataclasses.replace(model, qd=[], qdd=[]) if kin else model)
+    if claimed:
+        _check_rates(model, claimed)
+    # with kinematic equations, each speed u(t) is its expression in q and q' everywhere
+    speed_sub = {}
+    if kin:
+        us, sol = kin[0], kin[1]
+        speed_sub = {u.diff(TIME): sol[u].diff(TIME) for u in us} | sol
+    exprs = [e.xreplace(speed_sub) for e in _exprs(model, loads)]
     known = {x for x in model.q if _is_dynamic(x)} | {x for x in model.qd if _is_dynamic(x)}
     signal_map, extra = _inputs(model, exprs, mapping, known)
     mapping.update(signal_map)
@@ -275,6 +420,7 @@ def _convert(model: Model) -> Model:
         if isinstance(e, sp.MatrixBase):
             return e.applyfunc(conv)
         e = sp.sympify(e)
+        e = e.xreplace(speed_sub) if speed_sub else e
         e = e.xreplace(ders) if ders else e
         e = e.xreplace(rest) if rest else e
         left = [f for f in e.atoms(AppliedUndef) if _is_dynamic(f)] + [
@@ -287,6 +433,9 @@ def _convert(model: Model) -> Model:
     def conv_dict(d):
         return {k: conv(v) for k, v in d.items()}
 
+    speeds = {}
+    if kin:
+        speeds = {"u": [sp.Symbol(type(u).__name__) for u in kin[0]], "V": conv(kin[2]), "v": conv(kin[3])}
     quantities = {name: (ins, [(o, conv(sp.Matrix(m))) for o, m in outs], doc)
                   for name, (ins, outs, doc) in model.quantities.items()}
     return dataclasses.replace(
@@ -296,5 +445,5 @@ def _convert(model: Model) -> Model:
         nonholonomic=[conv(c) for c in model.nonholonomic], holonomic=[conv(c) for c in model.holonomic],
         steady=conv_dict(model.steady), cyclic=conv_dict(model.cyclic),
         equilibrium_approx=conv_dict(model.equilibrium_approx), formulas=conv_dict(model.formulas),
-        quantities=quantities, signals=list(model.signals) + extra,
+        quantities=quantities, signals=list(model.signals) + extra, kinematics=[], speeds=speeds,
         given_functions=[conv(f) for f in model.given_functions])

@@ -49,7 +49,24 @@ def _float_literal(x) -> str:
     return repr(float(x))
 
 
-class CPrinter(C99CodePrinter):
+_TERMS: dict = {}  # (Add, order) -> its terms in print order, shared by the printers of one emit
+
+
+class _SharedOrder:
+    """Each printer puts an Add's terms in sympy's order (as_ordered_terms: the terms'
+    sort keys), and the four printers print the same expressions: computed once per
+    expression and order for all of them, the same lists (a 12-link chain's emission
+    spent 6 s of its printing there)."""
+
+    def _as_ordered_terms(self, expr, order=None):
+        key = (expr, order or self.order)
+        got = _TERMS.get(key)
+        if got is None:
+            got = _TERMS[key] = super()._as_ordered_terms(expr, order=order)
+        return list(got)
+
+
+class CPrinter(_SharedOrder, C99CodePrinter):
     """C99 with small integer powers as products and constants as double literals."""
 
     def _print_Pow(self, expr):
@@ -73,7 +90,7 @@ class CPrinter(C99CodePrinter):
         return f"({_float_literal(expr.p)}/{_float_literal(expr.q)})"
 
 
-class NumpyPrinter(NumPyPrinter):
+class NumpyPrinter(_SharedOrder, NumPyPrinter):
     def _print_Pi(self, expr):
         return _float_literal(sp.pi)
 
@@ -81,7 +98,7 @@ class NumpyPrinter(NumPyPrinter):
         return f"({expr.p}/{expr.q})"
 
 
-class MpPrinter(MpmathPrinter):
+class MpPrinter(_SharedOrder, MpmathPrinter):
     """mpmath with exact constants: rationals as mpf quotients, pi at working precision."""
 
     def _print_Rational(self, expr):
@@ -95,7 +112,7 @@ class MpPrinter(MpmathPrinter):
         return super()._print_Pow(expr, rational=rational)
 
 
-class CasadiPrinter(PythonCodePrinter):
+class CasadiPrinter(_SharedOrder, PythonCodePrinter):
     """Python syntax over CasADi SX: elementary functions from the `ca` namespace."""
 
     _functions = {"sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh", "tanh",
@@ -194,6 +211,83 @@ class EmittedFunction:
     unread: list = ()  # the inputs of which the C reads no entry
 
 
+def count_ops(exprs) -> int:
+    """sum(sp.count_ops(e) for e in exprs), the same integer, with each distinct
+    subexpression counted once: sp.count_ops walks the tree, and an expression of the
+    derivation repeats its subtrees many times (a 12-link chain's sensitivities spent 7 s
+    in it). Its count is a sum of what each node it visits adds, each a function of the
+    node alone (SUB - ADD adds nothing to the total), so memoising by node gives the
+    same sum (tests/test_machinery.py holds it to sp.count_ops)."""
+    from sympy.core.function import _coeff_isneg
+    from sympy.core.operations import LatticeOp
+    from sympy.simplify.radsimp import fraction
+
+    memo: dict = {}
+
+    def local(a):
+        """(what node a adds, the nodes sp.count_ops visits after it)."""
+        if a.is_Rational:
+            if a is not sp.S.One:
+                return int(a.p < 0) + int(a.q != 1), ()
+        elif a.is_Mul:
+            c = 0
+            if _coeff_isneg(a):
+                c += 1
+                a = a.as_two_terms()[1] if a.args[0] is sp.S.NegativeOne else -a
+            n, d = fraction(a)
+            if n.is_Integer:
+                return c + 1 + (1 if n < 0 else 0), (d,)
+            if d is not sp.S.One:
+                return c + 1, ((d,) if not d.is_Integer else ()) + (n,)
+            return c + _generic(a)[0], _generic(a)[1]
+        elif a.is_Add:
+            c, pushed, negs = 0, [], 0
+            for i, ai in enumerate(a.args):
+                neg = _coeff_isneg(ai)
+                negs += neg
+                pushed.append(-ai if neg else ai)
+                c += i > 0
+            return c + int(negs == len(a.args)), pushed
+        return _generic(a)
+
+    def _generic(a):
+        if a.is_Pow and a.exp is sp.S.NegativeOne:
+            return 1, (a.base,)
+        if a == sp.S.Exp1:
+            return 1, ()
+        if a.is_Pow and a.base == sp.S.Exp1:
+            return 1, (a.exp,)
+        c = 0
+        if a.is_Mul or isinstance(a, LatticeOp):
+            c = len(a.args) - 1
+        elif a.args and (a.is_Pow or a.is_Function or isinstance(a, (sp.Derivative, sp.Integral, sp.Sum))):
+            c = 1
+        return c, (() if a.is_Symbol else a.args)
+
+    def total(root) -> int:
+        stack = [(root, False)]
+        while stack:
+            a, expanded = stack.pop()
+            if a in memo:
+                continue
+            c, pushed = local(a)
+            if not expanded:
+                stack.append((a, True))
+                stack.extend((b, False) for b in pushed if b not in memo)
+            else:
+                memo[a] = c + sum(memo[b] for b in pushed)
+        return memo[root]
+
+    out = 0
+    for e in exprs:
+        e = sp.sympify(e)
+        if not isinstance(e, sp.Expr) or e.is_Relational:
+            out += sp.count_ops(e)
+        else:
+            out += total(e)
+    return out
+
+
 def _cse(fn: Function):
     flat = []
     for _, mat in fn.outputs:
@@ -203,9 +297,9 @@ def _cse(fn: Function):
     missing = free - allowed
     if missing:
         raise ValueError(f"{fn.name}: symbols not among its inputs: {sorted(map(str, missing))}")
-    ops_before = sum(sp.count_ops(e) for e in flat)
+    ops_before = count_ops(flat)
     temps, reduced = sp.cse(flat, symbols=sp.numbered_symbols("t"), order="canonical")
-    ops = sum(sp.count_ops(e) for _, e in temps) + sum(sp.count_ops(e) for e in reduced)
+    ops = count_ops([e for _, e in temps] + list(reduced))
     return temps, reduced, ops, ops_before
 
 
@@ -616,7 +710,11 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
 
     # the largest first, so that the workers finish together
     size = [sum(len(mat) for _, mat in fn.outputs) for fn in functions]
-    done = parallel.pmap(one, len(functions), order=sorted(range(len(functions)), key=lambda i: -size[i]))
+    _TERMS.clear()
+    try:
+        done = parallel.pmap(one, len(functions), order=sorted(range(len(functions)), key=lambda i: -size[i]))
+    finally:
+        _TERMS.clear()
     emitted = {k: [d[k] for d in done] for k in printers}
     source = _shown(module_file)
     common = dict(model=model.name, title=model.title, paper=model.source, source=source,

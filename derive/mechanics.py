@@ -94,7 +94,11 @@ def _se_list(xs):
 def jacobian(exprs, wrt) -> sp.Matrix:
     """The matrix d exprs_i / d wrt_j, differentiated in SymEngine, as SymPy."""
     xs = _se_list(wrt)
-    return sp.Matrix([[_sp(_se(e).diff(x)) for x in xs] for e in exprs])
+    rows = []
+    for e in exprs:
+        f = _se(e)  # once per expression, not once per variable
+        rows.append([_sp(f.diff(x)) for x in xs])
+    return sp.Matrix(rows)
 
 
 TIME = sp.Symbol("t")  # explicit time (derive.model.TIME)

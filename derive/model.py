@@ -247,6 +247,16 @@ class Model:
     # paper's lambda is `lam`, M_motor `Mmotor`): {name typed: parameter's name}; every
     # command and the API take either (gyro.models.Model.parameters)
     aliases: dict = field(default_factory=dict)
+    # kinematic differential equations (sympy.physics.mechanics' kd_eqs, System's kdes):
+    # expressions zero on every motion, linear in the speeds `qd` (dynamicsymbols u(t))
+    # and the coordinates' derivatives q'(t), as KanesMethod takes them. With them the
+    # speeds are any n independent combinations of the rates (a body's angular-velocity
+    # components); without them a speed must be its coordinate's rate (derive/convert.py
+    # checks it and refuses what it cannot check)
+    kinematics: list = field(default_factory=list)
+    # set by the conversion from `kinematics` (derive/convert.py): {"u": the speeds'
+    # symbols, "V", "v": the rates q_d = V u + v, in the machinery's symbols}
+    speeds: dict = field(default_factory=dict)
 
     @property
     def signal_symbols(self) -> list:

@@ -13,9 +13,15 @@ the argument is zero: there it is NaN (`undefined_where`), never a number.
 What is refused, at derive time, in one line naming the term:
 - a kink of a rate in the Lagrangian (its momentum would jump: an impulse);
 - a Lagrangian that jumps across a kink (a step potential: an impulsive force);
-- a linearisation at a reference where the argument of a kink is zero (Coulomb friction
-  sign(x') about rest): the operator does not exist there. A reference where it is not
-  zero (friction on a moving belt, about rest) is linearised.
+
+A reference where the argument of a kink is zero (Coulomb friction sign(x') about rest)
+has no linearisation: the entries that need the derivative there are NaN at every set, and
+the full nonlinear equations are derived and emitted as everywhere else. A reference where
+it is not zero (friction on a moving belt, about rest) is linearised, NaN only at the sets
+where it is zero. Each kink whose derivative an entry needs is recorded
+(`Kinks.nondifferentiable`: its term, and its argument at the reference) and emitted into
+metadata ('nondifferentiable'), so that the runtime names the term when it refuses an
+operator that does not exist.
 """
 from __future__ import annotations
 
@@ -66,6 +72,9 @@ class Kinks:
 
     def __init__(self):
         self.by_term: dict = {}
+        # term -> its argument at the reference, for each kink an entry of the operator or
+        # of B needs the derivative of (undefined_where): "0" where it never exists
+        self.nondifferentiable: dict = {}
 
     def freeze(self, expr):
         e = rewrite(expr)
@@ -146,7 +155,8 @@ def undefined_where(kinks: Kinks, equations, variables, reference: dict, name: s
     depends on variable j is zero (a Piecewise, NaN where u = 0). At a reference where
     such an argument is zero identically, the derivative exists if the equation and its
     derivative are the same on both sides of the kink (quadratic drag -|v| v at rest);
-    anything else (Coulomb friction sign(v) at rest) is refused: no derivative there."""
+    anything else (Coulomb friction sign(v) at rest) has no derivative there: NaN at every
+    set. Each kink met is recorded in kinks.nondifferentiable."""
     out = sp.zeros(len(equations), len(variables))
     for i, e in enumerate(equations):
         free = sp.sympify(e).free_symbols
@@ -160,12 +170,13 @@ def undefined_where(kinks: Kinks, equations, variables, reference: dict, name: s
                 at = u.subs(reference)
                 if sp.simplify(at) != 0:
                     out[i, j] += sp.Piecewise((sp.nan, sp.Eq(at, 0)), (0, True))
+                    kinks.nondifferentiable[str(kinks.thaw(k.term))] = str(at)
                     continue
                 # at the kink: the derivative exists if the equation and its derivative
                 # (the kink held) are the same on both sides there, as -|v| v at v = 0
                 both = [(e_.subs(k.symbol, side), sp.diff(e_, x).subs(k.symbol, side))
                         for e_ in [sp.sympify(e)] for side in k.sides]
                 if any(sp.simplify(kinks.thaw(a - b).subs(reference)) != 0 for a, b in zip(*both)):
-                    raise Unsupported(f"{name}: the linearisation at the reference is refused: {kinks.thaw(k.term)} "
-                                      f"is not differentiable where {u} = 0, as it is there")
+                    out[i, j] = sp.nan  # at every set: the reference sits on the kink
+                    kinks.nondifferentiable[str(kinks.thaw(k.term))] = "0"
     return out

@@ -13,13 +13,13 @@ import random
 import sys
 import time
 from contextlib import contextmanager
-from dataclasses import dataclass, field
 
 import sympy as sp
 
 from derive import constraints, convert
 from derive import mechanics as mech
 from derive import names, nonsmooth, parallel
+from derive.derivation import Derivation, VariantResult  # noqa: F401  (pipeline.Derivation, as before)
 from derive.model import TIME, Function, Load, Model, Unsupported
 
 P_SYMBOL = sp.Symbol("p")  # the operator d/dt
@@ -48,67 +48,6 @@ class Steps:
     @property
     def total(self) -> float:
         return time.perf_counter() - self.t_start
-
-
-@dataclass
-class VariantResult:
-    operator: mech.LinearOperator  # unscaled, over the reduced coordinates
-    blocks: list[list[int]]  # indices into the reduced coordinates
-    charpoly: list[list]  # per block: coefficients of det J_block in z = p^2, lowest first
-    scaled: sp.Matrix  # J(p) with rows divided as the print does
-
-
-@dataclass
-class Derivation:
-    model: Model
-    mass_matrix: sp.Matrix  # full nonlinear equations: mass_matrix * qdd = forcing
-    forcing: sp.Matrix
-    routhian: object
-    rq: list  # reduced coordinates, velocities, accelerations (operator order)
-    rqd: list
-    rqdd: list
-    even: list  # reduced coordinates that are unknowns of the reference (not zero by symmetry)
-    equilibrium_residual: sp.Matrix  # minus the equations at the reference, function of `even`
-    operator: mech.LinearOperator  # exact, at the reference, function of `even`
-    route_agreement: float | None  # max |route1 - route2| / max |route2| at random points (None: one route)
-    order: list = field(default_factory=list)  # names of the reduced coordinates
-    rates: dict = field(default_factory=dict)  # velocity symbol -> rate on a steady motion
-    inputs: list = field(default_factory=list)  # w: columns of B (symbols)
-    input_matrix: sp.Matrix | None = None  # B of M q'' + D q' + K q = B w
-    time_dependent: bool = False  # t appears in the Lagrangian or the forces
-    variants: dict[str, VariantResult] = field(default_factory=dict)
-    functions: list[Function] = field(default_factory=list)
-    timings: list = field(default_factory=list)
-    constraints: dict = field(default_factory=dict)  # holonomic: eliminated, or multipliers
-    # the parameters made signals (Signal.parameter): {"signals": every signal of the model in
-    # its order, "varying": those that make a parameter time-varying, "mass_matrix",
-    # "forcing": the full equations with those parameters the signals' values, "sub":
-    # parameter symbol -> the signal's value}; empty for a model without them
-    varying: dict = field(default_factory=dict)
-
-    @property
-    def momenta(self) -> list:
-        """The cyclic momenta that are inputs (symbols that are not parameters)."""
-        return names.momentum_inputs(self.model)
-
-    @property
-    def driven(self) -> list:
-        """The symbols of the signals that stay in the operator (not inputs w)."""
-        return [s for sig in self.model.signals if not sig.input for s in sig.symbols]
-
-    def state(self, with_qe: bool = True) -> list:
-        """The input groups of everything about the reference: params, qe, momenta, time,
-        the driven signals; each present only when the model has it."""
-        g = [("params", self.model.symbols)]
-        if with_qe:
-            g.append(("qe", self.even))
-        if self.momenta:
-            g.append(("momenta", self.momenta))
-        if self.time_dependent:
-            g.append(("time", [TIME]))
-        if self.driven:
-            g.append(("signals", self.driven))
-        return g
 
 
 def _random_point(symbols, rng):
@@ -296,8 +235,12 @@ def _varying_equations(model: Model, L, Q, given, varying: list, signals: list) 
 def derive(model: Model, steps: Steps | None = None) -> Derivation:
     steps = steps or Steps()
     model = convert.convert(model)  # dynamicsymbols, assumptions, vectors: the machinery's symbols
+    _refuse_nonholonomic(model)  # before anything is solved
     model, varying, all_signals = _split_varying(model)
     eliminated = {}
+    if model.speeds and model.holonomic:
+        raise Unsupported(f"{model.name}: kinematic equations together with holonomic constraints: write the "
+                          "model in its independent coordinates, or in their rates")
     if model.holonomic:
         with steps("holonomic constraints: dependent coordinates solved for, or multipliers"):
             found = constraints.solve_dependent(model)
@@ -459,7 +402,32 @@ def derive(model: Model, steps: Steps | None = None) -> Derivation:
         _thawed(deriv, kinks, reference, undefined)
     deriv.model = source
     deriv.constraints = eliminated
+    deriv.nondifferentiable = dict(kinks.nondifferentiable)
+    if source.speeds:
+        with steps("equations in the speeds of the kinematic equations (Kane's form)"):
+            deriv.speeds = speeds_equations(source, deriv.mass_matrix, deriv.forcing)
     return deriv
+
+
+def speeds_equations(model: Model, Mq: sp.Matrix, f: sp.Matrix) -> dict:
+    """The equations Mq q'' = f in the speeds u of the kinematic equations, q' = V u + v:
+    with q'' = V u' + V' u + v' (V' and v' along the motion), premultiplied by V^T, which
+    is what Kane's equations are (the partial velocities of u_r are those of q' taken
+    through V's column r): V^T Mq V u' = V^T (f - Mq (V' u + v')), q' replaced by V u + v.
+    Refused with holonomic constraints (eliminated coordinates change the rates)."""
+    sp_ = model.speeds
+    u, V, v = sp.Matrix(sp_["u"]), sp_["V"], sp_["v"]
+    q, qd = model.q, model.qd
+    rate = {a: b for a, b in zip(qd, V * u + v)}
+
+    def dt(X):
+        return sum((X.diff(x) * r for x, r in zip(q, qd)), X.diff(TIME))
+
+    Vu = V.xreplace(rate)
+    accel = (dt(V) * u + dt(v)).xreplace(rate)
+    M = Vu.T * Mq.xreplace(rate) * Vu  # as they come: expanding took a top's 0.6 s
+    F = Vu.T * (f.xreplace(rate) - Mq.xreplace(rate) * accel)
+    return {"u": list(u), "kinematics": (V * u + v), "mass_matrix": M, "forcing": F}
 
 
 def _with_multipliers(model: Model, steps: Steps) -> Derivation:
@@ -467,6 +435,9 @@ def _with_multipliers(model: Model, steps: Steps) -> Derivation:
     with steps("checks: names, what the machinery supports"):
         names.check_model(model)
         _refuse_nonholonomic(model)
+        if model.speeds:
+            raise Unsupported(f"{model.name}: kinematic equations together with holonomic constraints that "
+                              "need multipliers")
         Q = generalized_forces(model)
         exprs = [sp.sympify(model.lagrangian)] + [sp.sympify(x) for x in (Q or [])]
         if any(e.has(*NONSMOOTH) for e in exprs):
@@ -548,6 +519,9 @@ def metadata(d: Derivation) -> dict:
     }
     if d.constraints:
         meta["constraints"] = d.constraints
+    if d.nondifferentiable:
+        meta["nondifferentiable"] = [{"term": t, "argument_at_reference": a}
+                                     for t, a in sorted(d.nondifferentiable.items())]
     if model.aliases:
         unknown = sorted(set(model.aliases.values()) - {p.name for p in model.parameters})
         if unknown:

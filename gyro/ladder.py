@@ -52,7 +52,51 @@ def spectrum(model: Model, params, method: str = "default", tol: float = DEFAULT
         empty = np.zeros((0, n))
         return Spectrum(method, empty, empty.copy(), empty.copy(),
                         np.zeros((0, len(model.meta["equilibrium_coordinates"]))), np.zeros(0, object))
+    if model.meta.get("nondifferentiable"):
+        return _where_linearisable(model, P, method, tol)
     return steady_roots(model, get(method).solve(model, P, tol))
+
+
+class OperatorUndefined(ArithmeticError):
+    """The linear operator does not exist at a set: a non-smooth term (derive/nonsmooth.py)
+    sits on its kink at the reference."""
+
+
+def _where_linearisable(model: Model, P, method: str, tol: float) -> Spectrum:
+    """A model with non-smooth terms whose derivative the operator needs (metadata
+    'nondifferentiable'): the sets where the operator is not finite at a finite equilibrium
+    have no linearisation; one such set alone is refused naming the terms, a batch answers
+    its other sets and gives those NaN (no verdict: 'failed')."""
+    from gyro.equilibrium import equilibria, operators
+
+    qe, ok = equilibria(model, P)
+    undefined = np.zeros(len(P), bool)
+    if ok.any():
+        k = np.flatnonzero(ok)
+        M, D, K = operators(model, P[k], qe[k])
+        finite = np.all(np.isfinite(M), axis=(1, 2)) & np.all(np.isfinite(D), axis=(1, 2)) & np.all(
+            np.isfinite(K), axis=(1, 2))
+        undefined[k[~finite]] = True
+    if not undefined.any():
+        return steady_roots(model, get(method).solve(model, P, tol))
+    if undefined.all() and len(P) == 1:
+        terms = "; ".join(f"{t}, its argument there {a}" for t, a in
+                          ((d["term"], d["argument_at_reference"]) for d in model.meta["nondifferentiable"]))
+        raise OperatorUndefined(f"no linear operator at this set: a non-smooth term of the model sits on its kink "
+                                f"at the reference, where it has no derivative (of {terms}); the nonlinear "
+                                "equations hold there (gyro simulate)")
+    good = np.flatnonzero(~undefined)
+    n = len(model.meta["reduced"])
+    shape = (len(P), n)
+    freq, growth, err = np.full(shape, np.nan), np.full(shape, np.nan), np.full(shape, np.nan)
+    eq = np.full((len(P), len(model.meta["equilibrium_coordinates"])), np.nan)
+    if good.size:
+        sub = steady_roots(model, get(method).solve(model, P[good], tol))
+        freq[good], growth[good], err[good] = sub.frequencies, sub.growth, sub.error_estimate
+        if sub.equilibrium is not None:
+            eq[good] = sub.equilibrium
+        return Spectrum(method, freq, growth, err, eq, growth_known=sub.growth_known)
+    return Spectrum(method, freq, growth, err, eq)
 
 
 def steady_roots(model: Model, spec: Spectrum) -> Spectrum:

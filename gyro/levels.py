@@ -7,6 +7,10 @@ which questions a level answers, its bound per quantity as a rule evaluated per 
 emitted expression, plus the evaluator's own estimate where declared), where the bound
 cannot be evaluated, and its measured cost. It knows no model and no question by name.
 
+A ladder declaration's bound expression is the rounding of its inputs in double precision
+(the conditioning of u cos(phi) near the pole); the methods it names in "exact_inputs"
+evaluate the parameters in their own precision and carry only their estimate.
+
 One declaration may name several methods ({"kind": ..., "methods": [...]}): it stands for
 one level per method, named LEVEL:METHOD, each costing its entry of a declared cost
 {METHOD: s}, or, for a method of the frequency ladder, the method's COST. That is the ladder's axis of the hierarchy; the model approximations are
@@ -147,7 +151,7 @@ def bounds(model: Model, level: Level, question: str, P: np.ndarray, n_quantitie
         if e is None:
             apriori[:, j] = np.inf
             continue
-        if e["row"] is not None:
+        if e["row"] is not None and level.evaluator.get("method") not in level.evaluator.get("exact_inputs", ()):
             apriori[:, j] = np.abs(rows[:, e["row"]])
         estimate[j] = e["estimate"]
     invalid = np.full(N, "", object)

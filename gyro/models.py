@@ -96,14 +96,45 @@ class Model:
         the symbol lam), or the name itself."""
         return self.meta.get("aliases", {}).get(name, name)
 
+    @property
+    def aliases(self) -> dict[str, str]:
+        """{another name a command takes: the declared parameter it names} (the paper's lambda
+        for lam, M_motor for Mmotor). Every command prints the declared name and takes both."""
+        return dict(self.meta.get("aliases", {}))
+
+    def known_names(self) -> str:
+        """The declared parameter names, and the other names taken for them."""
+        also = ", ".join(f"{a} for {n}" for a, n in self.aliases.items())
+        return " ".join(self.param_names) + (f" (also {also})" if also else "")
+
+    def param_name(self, name: str, what: str = "parameter") -> str:
+        """The declared name of the parameter a user named, by that name or another name taken
+        for it (`aliases`); a ParameterError naming `what` (an option: --x, --spin) otherwise."""
+        key = self.canonical(name)
+        if key not in self.param_names:
+            raise ParameterError(f"{what} {name!r}: unknown parameter; known: {self.known_names()}")
+        return key
+
+    def named(self, values: dict) -> dict:
+        """Values by the declared names, and also under each other name a command printed them
+        by before (the JSON of `gyro stability` and `gyro simulate` keyed lambda and M_motor):
+        their readers keep their keys."""
+        out = {k: float(v) for k, v in values.items()}
+        out.update({a: out[n] for a, n in self.aliases.items() if n in out})
+        return out
+
     def parameters(self, overrides: dict | None = None) -> dict[str, float]:
         """Every parameter's value: the paper example's, replaced by `overrides`; validated."""
         values = self.defaults
         by_name = {p.name: p for p in self.params}
-        for key, raw in (overrides or {}).items():
-            key = self.canonical(key)  # a name typed for a symbol the code cannot carry
+        given = {}
+        for typed, raw in (overrides or {}).items():
+            key = self.canonical(typed)  # a name typed for a symbol the code cannot carry
+            if key in given and given[key] != typed:
+                raise ParameterError(f"parameter {key}: given twice (as {given[key]} and {typed})")
+            given[key] = typed
             if key not in by_name:
-                raise ParameterError(f"unknown parameter {key!r} for {self.name}; known: {' '.join(self.param_names)}")
+                raise ParameterError(f"unknown parameter {key!r} for {self.name}; known: {self.known_names()}")
             try:
                 value = float(raw)
             except (TypeError, ValueError):

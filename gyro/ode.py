@@ -87,7 +87,9 @@ def symbolic(model: Model, varying: bool = False) -> Symbolic:
         # the mass matrix's own inputs after (params, q): those of the forcing by name
         by_name = {spec["name"]: x for spec, x in zip(specs, extra)}
         mm = [by_name[spec["name"]] for spec in meta["mass_matrix" + suffix]["inputs"][2:]]
-        ydot = ca.vertcat(y[n:], ca.solve(getattr(cf, "mass_matrix" + suffix)(p, y[:n], *mm), f))
+        # with multipliers (metadata 'constraints'), the system's unknowns are (qdd, lambda):
+        # the accelerations are its first n (an index-1 form, integrated as it is)
+        ydot = ca.vertcat(y[n:], ca.solve(getattr(cf, "mass_matrix" + suffix)(p, y[:n], *mm), f)[:n])
         _CACHE[key] = Symbolic(y, p, extra, ydot)
     return _CACHE[key]
 

@@ -63,23 +63,34 @@ def refine(M, D, K, lam: complex, iters: int = 8) -> tuple[complex, float]:
 
 
 def representatives(lams: np.ndarray, n: int) -> np.ndarray:
-    """One root of each pair of the 2n eigenvalues of a gyroscopic system.
+    """One root of each pair of the 2n eigenvalues of a real quadratic eigenproblem: a mode.
 
-    The spectrum is symmetric under lambda -> -lambda and lambda -> conj(lambda). A root
-    that is essentially imaginary (|Im| > |Re|) is represented by its member with Im > 0 (a
-    flutter quadruple gives two, growing and decaying); an essentially real pair +-sigma
-    (divergent instability) by its member with Re >= 0, so that no growth rate is hidden."""
+    The eigenvalues of a real problem come in conjugate pairs lambda, conj(lambda); a mode
+    is such a pair, whatever |Re| and |Im| are, and is represented by its member with
+    Im > 0. A flutter quadruple +-a +- ib of a gyroscopic system is two modes, one growing
+    (a + ib) and one decaying (-a + ib). Real roots are their own conjugates: the 2c complex
+    roots give c modes, and the n - c further representatives are the real roots of largest
+    Re (a divergent pair +-sigma gives +sigma, so that no growth rate is hidden)."""
     return lams[representative_indices(lams, n)]
 
 
 def representative_indices(lams: np.ndarray, n: int) -> np.ndarray:
-    """The indices into lams of `representatives`, in the same order."""
-    imaginary = np.abs(lams.imag) > np.abs(lams.real)
-    keep = np.flatnonzero(np.where(imaginary, lams.imag > 0, lams.real >= 0))
-    if len(keep) != n:  # zeros or rounding broke the symmetry: take the n most "upper"
-        key = np.where(imaginary, lams.imag, lams.real)
-        keep = np.argsort(-key)[:n]
-    return keep
+    """The indices into lams of `representatives`, in the same order. A root counts as
+    real where |Im| <= REAL |lambda| (the rounding of a real root's imaginary part by an
+    eigensolver that does not return exact conjugates; LAPACK's are exact)."""
+    lams = np.asarray(lams)
+    real = np.abs(lams.imag) <= REAL * np.abs(lams)
+    upper = ~real & (lams.imag > 0)
+    need = n - int(upper.sum())
+    if 0 <= need <= int(real.sum()) and int((~real & (lams.imag < 0)).sum()) == int(upper.sum()):
+        r = np.flatnonzero(real)
+        keep = np.concatenate([np.flatnonzero(upper), r[np.argsort(-lams.real[r], kind="stable")[:need]]])
+        return np.sort(keep)
+    # rounding broke the pairing: the n most "upper", then the largest Re
+    return np.sort(np.lexsort((-lams.real, -np.round(lams.imag / np.maximum(np.abs(lams), 1e-300), 12)))[:n])
+
+
+REAL = 64 * EPS
 
 
 def refine_all(M, D, K, lams: np.ndarray, chosen: np.ndarray):
@@ -356,6 +367,33 @@ def input_rounding(model: Model, p, roots, solve, rel=4 * EPS) -> np.ndarray:
     order = np.argsort(mags)
     out = np.empty(len(roots))
     out[order] = np.abs(after - mags[order]) / np.maximum(mags[order], 1e-300)
+    return out
+
+
+CLOSE = 1e-6  # roots within CLOSE of each other, relative: a cluster, sensitive to the inputs
+
+
+def cluster_rounding(p, roots, solve, rel=4 * EPS) -> np.ndarray:
+    """The part of each root's error that comes from rounding the inputs, for the roots of a
+    cluster (another root within CLOSE of it, relative): a c-fold root moves by the c-th root
+    of a perturbation (a near-Jordan block at a collision: by its square root, 1e-8 for
+    4 eps), which no estimate of the solve at the given inputs sees. The set is solved again
+    with every parameter moved by +rel and by -rel relative (moved: signs alternating over
+    the parameters, fixed), and each clustered root's distance to the nearest root of each,
+    relative, is the estimate (the larger of the two); zero for the other roots. E.g. a
+    sleeping top at its critical spin to the last digit: the 40-digit roots are on the axis
+    and 1e-9 apart at the given doubles, and off it at inputs moved by 4 eps."""
+    lam = np.asarray(roots, complex)
+    mags = np.abs(lam)
+    d = np.abs(lam[:, None] - lam[None, :]) + np.diag(np.full(len(lam), np.inf))
+    close = (mags > 0) & np.any(d <= CLOSE * np.maximum(mags[:, None], mags[None, :]), axis=1)
+    out = np.zeros(len(lam))
+    if not close.any():
+        return out
+    for sign in (1.0, -1.0):
+        after = np.asarray(solve(moved(np.asarray(p, dtype=float), sign * rel)), complex)
+        change = np.min(np.abs(lam[close][:, None] - after[None, :]), axis=1) / mags[close]
+        out[close] = np.maximum(out[close], np.where(np.isfinite(change), change, np.inf))
     return out
 
 

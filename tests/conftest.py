@@ -18,17 +18,18 @@ MODEL = "torsion_gyrocompass"
 TIERS = {
     "unit": ("test_mechanics", "test_machinery", "test_architecture", "test_results", "test_model_namespace"),
     "generated": ("test_generated", "test_textbook", "test_docs_models", "test_derivation", "test_docs_api",
-                  "test_mechanics_style", "test_derive_baselines", "test_parallel_derive"),
+                  "test_mechanics_style", "test_speeds", "test_closed_chains", "test_derive_baselines", "test_parallel_derive"),
     "paper": ("test_paper", "test_anchors", "test_nonlinear", "test_gimbal", "test_gimbal_closed_form",
               "test_gimbal_section6", "test_gimbal_paper_items", "test_paper_items",
               "test_gyrohorizoncompass", "test_verdict", "test_ghc_paper_items", "test_ghc_motion", "test_precession",
-              "test_precession_base"),
+              "test_precession_base", "test_precession_bounds"),
     "methods": ("test_ladder", "test_companion_bound", "test_sensitivity", "test_hierarchy", "test_torsion_motion",
                 "test_scene_figures", "test_harmonic", "test_block_starts", "test_anymodel", "test_roots",
-                "test_equilibrium_c"),
+                "test_equilibrium_c", "test_rightmodel"),
     "properties": ("test_properties",),
     "cli": ("test_cli", "test_gimbal_simulate", "test_readme", "test_sweep", "test_wheel", "test_ghc_cli", "test_fuzz", "test_robustness",
-            "test_tolerance", "test_executor", "test_precession_cli", "test_forced", "test_unbalance_lagrangian"),
+            "test_tolerance", "test_executor", "test_motion_generic", "test_precession_cli", "test_forced",
+            "test_unbalance_lagrangian", "test_campbell_stability", "test_param_names"),
 }
 _TIER_OF = {f: tier for tier, files in TIERS.items() for f in files}
 
@@ -88,6 +89,15 @@ def tg_derivation():
 @pytest.fixture(scope="session")
 def tg_functions():
     return derived(MODEL)[2]
+
+
+NOTICES = ("gyro: deriving the model file", "gyro: compiling the generated C")
+
+
+def error_lines(err: str) -> list[str]:
+    """stderr's lines but a model's first-use notices (deriving a model file, compiling its
+    C), which a cold cache prints before the command's own line."""
+    return [ln for ln in err.strip().splitlines() if not ln.startswith(NOTICES)]
 
 
 def run_cli(*args):

@@ -188,7 +188,7 @@ def test_campbell_json_contract_and_bad_input(rotor, tmp_path):
     assert set(doc) >= {"model", "spin", "values", "spin_rate", "frequencies", "growth", "damping_ratio",
                         "log_dec", "whirl", "crossings"}
     assert doc["spin"] == "Omega" and doc["values"][0] == 0.0 and len(doc["frequencies"]) == 6
-    assert set(doc["crossings"][0]) == {"k", "mode", "value", "spin_rate", "frequency"}
+    assert set(doc["crossings"][0]) == {"k", "mode", "value", "spin_rate", "frequency", "branch"}
     assert (tmp_path / "c.png").read_bytes()[:4] == b"\x89PNG"
     for args, word in ((["--spin-range", "-1", "10"], "--spin-range"), (["--spin", "m"], "--spin"),
                        (["--spin", "nope"], "--spin"), (["--harmonics", "1,x"], "--harmonics"),

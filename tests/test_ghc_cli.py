@@ -156,8 +156,10 @@ def test_stability_json_has_the_contract_keys():
     # 2e-12, against margins of 0.06 and more: decided by ten orders of magnitude
     assert all(0 < d["margin_bounds"][k] < 1e-10 * d["conditions"][k] for k in d["conditions"])
     assert d["model"] == "gyrohorizoncompass"
-    assert set(d["params"]) == {"A", "B", "C", "J", "L", "I", "nu", "zeta", "eta", "lambda"}
+    # the declared names, and lambda (the key before every command printed lam) beside lam
+    assert set(d["params"]) == {"A", "B", "C", "J", "L", "I", "nu", "zeta", "eta", "lam", "lambda"}
     assert math.isclose(d["params"]["lambda"], 1.05, rel_tol=1e-14)  # 1 + chi by default
+    assert d["params"]["lam"] == d["params"]["lambda"]
     assert set(d["equilibrium"]) == {"alpha", "beta", "gamma", "epsilon0"}
     assert math.isclose(d["equilibrium"]["epsilon0"], math.acos(1.05 * 0.5 / 1.0), rel_tol=1e-14)
     assert math.isclose(d["theta"], 0.1, rel_tol=1e-12) and math.isclose(d["chi"], 0.05, rel_tol=1e-12)

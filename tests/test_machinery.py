@@ -542,3 +542,30 @@ def test_a_parameter_made_time_varying_is_emitted_again_and_the_rest_is_unchange
 def test_a_parameter_made_time_varying_wrongly_is_refused(signal, needle):
     with pytest.raises(Unsupported, match=re.escape(needle)):
         _derive(_conveyor(signals=[signal]))
+
+
+def test_emitted_operation_counts_are_sympys():
+    """derive.emit.count_ops (each distinct subexpression once) gives sp.count_ops's sum on
+    expressions built at random from every construct the count treats on its own:
+    negations, rationals, quotients, exp, powers, functions, and on the tricky ones named."""
+    import random
+
+    from derive.emit import count_ops
+
+    x, y, z = sp.symbols("x y z")
+    named = [x - y, -x - y, -x + y, -2 * x, -x / 3, 2 / x, -2 / x, sp.exp(1), sp.E * x, 1 / (x + y),
+             sp.Max(x, y, z), sp.sign(x - y) * sp.Abs(x), sp.Piecewise((sp.nan, sp.Eq(x, 0)), (0, True)),
+             sp.Rational(-3, 4), sp.Integer(0), sp.S.One, (x * y) ** -2, x**2 * y**-3 / 7, sp.Function("f")(x) / -2]
+    rng = random.Random(5)
+
+    def rand(depth):
+        if depth == 0:
+            return rng.choice([x, y, z, sp.Integer(rng.randint(-3, 3)), sp.Rational(rng.randint(-5, 5), rng.randint(1, 4))])
+        a, b = rand(depth - 1), rand(depth - 1)
+        return rng.choice([lambda: a + b, lambda: a - b, lambda: a * b, lambda: a / b if b != 0 else a,
+                           lambda: sp.sin(a), lambda: a ** rng.choice([2, -1, -2, sp.Rational(1, 2)]) if a != 0 else a,
+                           lambda: -a, lambda: sp.exp(a)])()
+
+    exprs = named + [rand(rng.randint(1, 5)) for _ in range(400)]
+    assert [count_ops([e]) for e in exprs] == [sp.count_ops(e) for e in exprs]
+    assert count_ops(exprs) == sum(sp.count_ops(e) for e in exprs)

@@ -142,6 +142,29 @@ def test_non_smooth_functions_through_every_backend(belt):
     assert np.isnan(K).all() and call(E, "operator", defaults | {"x": 0.3}, "c")[2][0, 0] == 44.0
 
 
+def test_coulomb_friction_at_rest_derives_its_equations_and_no_operator(tmp_path):
+    """A block with Coulomb friction mu m g sign(x') about rest: the full nonlinear
+    equations derive and are emitted (sign through every backend, sign(0) = 0); the
+    operator's damping entry, which needs the derivative of sign at 0, is NaN at every set,
+    and metadata names the term (the runtime refuses the operator with it)."""
+    import json
+
+    from derive.__main__ import main
+
+    src = tmp_path / "block.py"
+    src.write_text(BODY.format(change="Q = {'x': -sp.Rational(3, 10) * m * 9.81 * sp.sign(x_d)}"))
+    assert main(["--model", str(src), "--out", str(tmp_path / "out")]) == 0
+    meta = json.loads((tmp_path / "out" / "broken" / "metadata.json").read_text())
+    assert meta["nondifferentiable"] == [{"term": "sign(x_d)", "argument_at_reference": "0"}]
+    E = _finish("broken", None, None, {}, tmp_path / "out")
+    for backend in BACKENDS:
+        for xd, want in ((0.3, -0.3 * 9.81 - 4 * 0.1), (-0.3, 0.3 * 9.81 - 4 * 0.1), (0.0, -4 * 0.1)):
+            f = call(E, "forcing", {"m": 1.0, "k": 4.0, "x": 0.1, "x_d": xd}, backend)[0]
+            assert_close(f.ravel(), np.array([want]), what=f"{backend} forcing at x_d = {xd}")
+        M, D, K = call(E, "operator", {"m": 1.0, "k": 4.0, "x": 0.0}, backend)
+        assert np.isnan(D).all() and M.ravel()[0] == 1.0 and K.ravel()[0] == 4.0, backend
+
+
 # --------------------------------------------------------------------------- one-line refusals
 
 BODY = textwrap.dedent('''
@@ -171,7 +194,6 @@ BODY = textwrap.dedent('''
     ("L = [L]", "not a SymPy expression (a list)"),
     ("L = L + sp.Function('f')(x)", "f(x) is a function that the model does not declare"),
     ("L = L + sp.Piecewise((x, x > 0), (0, True))", "Piecewise"),
-    ("Q = {'x': -sp.sign(x_d)}", "sign(x_d) is not differentiable where x_d = 0"),
     ("L = L - sp.Heaviside(x - 1)", "the Lagrangian jumps where x - 1 = 0"),
     ("L = L + sp.Abs(x_d)", "a non-smooth function of the rates"),
     ("Q = {'x': dynamicsymbols('F').diff()}; extra = dict(signals=[__import__('derive.model', fromlist=['Signal'])"

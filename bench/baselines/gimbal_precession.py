@@ -4,7 +4,7 @@ forcing of the three bodies.
 
 As a user writes it: an inertial frame Ni; the base Bs turning at u = u_xi xi + u_eta eta +
 u_zeta zeta (constant components in its own axes); the outer ring Rg = Bs rotated by alpha
-about xi (moment C3 about its axis, transverse moments neglected as in the model); the
+about xi (moments C3 about its axis xi1, C1 about eta1, C2 about zeta1); the
 casing Cs = Rg rotated by beta about eta1 = y' (diag(B2, B1, B3) in x' y' z'); the rotor
 Rt = Cs rotated by phi about z' (A1, A1, A3); all about the fixed centre O. Torques, each
 acting on a body with its reaction on the neighbouring one where the model has it:
@@ -27,10 +27,10 @@ def run(point: dict) -> dict:
     t_import = time.perf_counter() - t0
     t1 = time.perf_counter()
     names = ("u_xi u_eta u_zeta f_alpha f_beta f_phi Mmotor k_xi1 l_x l_y l_z m_x m_y m_z "
-             "C3 B1 B2 B3 A1 A3")
+             "C3 C1 C2 B1 B2 B3 A1 A3")
     syms = sp.symbols(names)
     (u_xi, u_eta, u_zeta, f_alpha, f_beta, f_phi, Mmotor, k_xi1, l_x, l_y, l_z, m_x, m_y, m_z,
-     C3, B1, B2, B3, A1, A3) = syms
+     C3, C1, C2, B1, B2, B3, A1, A3) = syms
     alpha, beta, phi = q = me.dynamicsymbols("alpha beta phi")
     t = me.dynamicsymbols._t
     qd = [x.diff(t) for x in q]
@@ -43,7 +43,7 @@ def run(point: dict) -> dict:
     Rt = Cs.orientnew("Rt", "Axis", [phi, Cs.z])
     O = me.Point("O")
     O.set_vel(Ni, 0)
-    ring = me.RigidBody("ring", O, Rg, 0, (me.inertia(Rg, C3, 0, 0), O))
+    ring = me.RigidBody("ring", O, Rg, 0, (me.inertia(Rg, C3, C1, C2), O))
     casing = me.RigidBody("casing", O, Cs, 0, (me.inertia(Cs, B2, B1, B3), O))
     rotor = me.RigidBody("rotor", O, Rt, 0, (me.inertia(Rt, A1, A1, A3), O))
     Lag = me.Lagrangian(Ni, ring, casing, rotor)

@@ -477,9 +477,11 @@ def section3_formulas():
         put(f"quartic_c{k_}", c, f"(3.10): coefficient of z^{k_} in K0 L(z,b') - z m_* L(z,b'')")
     # the a-priori bounds of the levels on the paper's operator (levels(), docs/hierarchy.md)
     beta0, gamma20 = H * u3 / (G + H * u2), H * u3 / Kgamma
-    paper = put("bound_paper", F["eps2"] + m * g / (Kp * sp.Abs(l2)) + sp.Abs(beta0) + sp.Abs(gamma20) + u / F["Omega"],
+    paper = put("bound_paper", F["eps2"] + m * g / (Kp * sp.Abs(l2)) + sp.Abs(beta0) + sp.Abs(gamma20)
+                + u * (A + I1 + I2 + I3) / H,
                 "the bound of the paper operator (2.4) against the exact one: eps2 + m g/(K_p |l2|) (the "
-                "sag) + |beta0| + |gamma2| of (2.2) + u/Omega")
+                "sag) + |beta0| + |gamma2| of (2.2) + (A + I1 + I2 + I3) u/H (approximation 4: every A u "
+                "and I_i u against H, the casing's as well as the rotor's A u/H = u/Omega)")
     put("bound_blocks", paper + 2 * (H * u2 / Kgamma + H * u2 / G) + 2 * F["eps1"],
         "the bound of the decoupled blocks (u = 0 in (2.4)): bound_paper + 2 (H u2/K_gamma + H u2/G) + 2 eps1")
     return F, doc
@@ -543,6 +545,10 @@ def levels(F):
     estimate (mode_formulas)."""
     from derive.model import Bound, Level
 
+    # a certificate counts the exact operator as evaluated in double precision; the rounding of
+    # its inputs (u cos(phi), linear_exact's a-priori part) separates that from the exact model
+    certified = {"inputs": "linear_exact"}
+
     paper, blocks = F["bound_paper"], F["bound_blocks"]
     blocks_edges = {"Earth rate below the slowest pendulum frequency (eps1 < 1/4)": sp.Rational(1, 4) - F["eps1"],
                     "l2 != 0 (the sag's bound)": sp.Abs(l2)}
@@ -553,7 +559,7 @@ def levels(F):
     motion = {"quantities": list(REDUCED), "scale": "excursion"}
     return [
         Level("formulas", "everything (3.2)-(3.28) drop: each formula's small parameter to its order",
-              {"kind": "spectrum", "method": "formulas"}, {"frequencies": Bound(estimate=True)},
+              {"kind": "spectrum", "method": "formulas", "certify": certified}, {"frequencies": Bound(estimate=True)},
               reference="linear_exact",
               doc="the paper's approximate formulas, corrected, with their derived estimates"),
         # costs measured by bench/levels.py (one core, 20,000 sets): since the roots are proven
@@ -564,20 +570,21 @@ def levels(F):
               {"kind": "formulas", "roots": {"function": "paper_charpoly", "block": 2, "set": {"u": 0.0, "g": 0.0},
                                              "modes": ["nutation a", "nutation b", "nutation c", "nutation d"],
                                              "shift": {"parameter": "g", "function": "paper_charpoly_dg", "correct": True},
-                                             "apriori": "bound_blocks"}},
+                                             "apriori": "bound_blocks"}, "certify": certified},
               {"frequencies": Bound(estimate=True)},
               valid=blocks_edges,
               cost=4.4e-6, reference="linear_exact",
               doc="the roots of the quartic (3.10) for the four nutation modes, with twice the first-order "
                   "gravity shift of each as its estimate; the other six modes by (3.2)-(3.9)"),
         Level("decoupled", "the Earth-rate coupling of the two blocks (eps1 = 0, (3.1)), and what (2.4) drops",
-              {"kind": "charpoly", "function": "paper_charpoly", "set": {"u": 0.0}},
+              {"kind": "charpoly", "function": "paper_charpoly", "set": {"u": 0.0}, "certify": certified},
               {"frequencies": [None] + [Bound(blocks, estimate=True)] * (n - 1)},
               valid=blocks_edges,
               cost=2.9e-6, reference="linear_exact",
               doc="the blocks J', J'' of (2.4) at u = 0: roots of their characteristic polynomials"),
         Level("linear_paper", "linearisation at q = 0 (offsets of (2.2)), u3 terms, u^2 terms, A u and I_i u against H",
-              {"kind": "charpoly", "function": "paper_charpoly"}, {"frequencies": Bound(paper, estimate=True)},
+              {"kind": "charpoly", "function": "paper_charpoly", "certify": certified},
+              {"frequencies": Bound(paper, estimate=True)},
               valid={"l2 != 0 (the sag's bound)": sp.Abs(l2)},
               cost=3.0e-6, reference="linear_exact",
               doc="the paper's printed operator (2.4), corrected: roots of its blocks' characteristic polynomials"),
@@ -604,9 +611,16 @@ def levels(F):
               {"kind": "trajectory", "analysis": "torsion_motion", "method": "DOP853", "rtol": 1e-9, **motion},
               {"motion": Bound(estimate=True)}, cost=3.7,
               doc="the full 11-coordinate equations integrated (DOP853 at rtol 1e-9 and 1e-11, SciPy)"),
+        # the double-precision methods take u2 = u cos(phi) rounded: cos(x) at x = phi pi/180 turns
+        # the rounding of x into a relative eps |x tan x| of u2 (1e-13 at 89.9 deg), which their
+        # estimates do not see where the spectrum is not wide (default: 1.5e-14 against an
+        # estimate of 1.26e-14 at H/20, 89.9 deg); omega1^2 is proportional to u2, and a
+        # frequency moves at most by the relative change of its stiffness
         Level("linear_exact", exact,
-              {"kind": "spectrum", "methods": ["polyroots", "companion", "default", "reference"], "default": "default"},
-              {"frequencies": Bound(estimate=True), "stability": Bound(estimate=True)},
+              {"kind": "spectrum", "methods": ["polyroots", "companion", "default", "reference"], "default": "default",
+               "exact_inputs": ["reference"]},
+              {"frequencies": Bound(sp.Float(2.0**-52) * (sp.Abs(phi_rad * sp.tan(phi_rad)) + 1), estimate=True),
+               "stability": Bound(estimate=True)},
               reference="linear_exact:reference",
               doc="the exact operator about the exact equilibrium, by a method of the ladder (docs/methods.md)"),
     ]

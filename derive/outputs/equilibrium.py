@@ -34,6 +34,8 @@ def _system(d) -> Function | None:
     function (one CSE: the operator's M, D and the other rows and columns of K are not
     evaluated). None where an equilibrium coordinate is not a reduced one."""
     names, order = [str(x) for x in d.even], list(d.order)
+    if d.constraints.get("multipliers"):
+        return _constrained_system(d)
     if not names or not set(names) <= set(order):
         return None
     idx = [order.index(c) for c in names]
@@ -43,6 +45,21 @@ def _system(d) -> Function | None:
                     "The Newton system of the equilibria: the rows of equilibrium_residual and the "
                     f"rows and columns of the operator's K at the equilibrium coordinates ({', '.join(names)}); "
                     "r(qe + dq) = r(qe) - K dq to first order.", ("K",))
+
+
+def _constrained_system(d) -> Function:
+    """A model with multipliers (derive/constraints.py): its equilibrium has all n
+    coordinates as unknowns, on the constraint. The Newton system is the n - m rows of the
+    reduced residual C' f0 and the m constraints phi(q) = 0, K = -(their Jacobian in q), so
+    that r(qe + dq) = r(qe) - K dq as for every other model."""
+    phi = sp.Matrix([sp.sympify(c) for c in d.model.holonomic])
+    r = sp.Matrix.vstack(sp.Matrix(d.equilibrium_residual), phi)
+    K = -r.jacobian(list(d.even))
+    return Function("equilibrium_system", d.state(), [("r", r), ("K", K)],
+                    "The Newton system of the equilibrium on the constraints: the rows of "
+                    f"equilibrium_residual ({', '.join(d.order)}) and the constraints phi(q) = 0, over all "
+                    f"coordinates ({', '.join(map(str, d.even))}); K = -dr/dq, r(qe + dq) = r(qe) - K dq to "
+                    "first order.", ("K",))
 
 
 def _extra(d) -> str:

@@ -30,6 +30,19 @@ def functions(d) -> list[Function]:
                  "Mq qdd = f, with the given functions' values and derivatives as inputs"
                  + note + "."),
     ]
+    if d.speeds:  # the speeds of the kinematic equations (Model.kinematics), as KanesMethod's
+        u = ("speeds", d.speeds["u"])
+        fns += [
+            Function("kinematics", [params, ("q", model.q), u] + timed, [("qd", d.speeds["kinematics"])],
+                     "The coordinates' rates from the speeds: qd = V(q) u + v(q), the kinematic equations "
+                     "solved."),
+            Function("speeds_mass_matrix", [params, ("q", model.q)] + timed, [("Mu", d.speeds["mass_matrix"])],
+                     "Mass matrix of the equations in the speeds, Mu ud = fu: V' Mq V (Kane's equations).",
+                     MATRICES),
+            Function("speeds_forcing", [params, ("q", model.q), u] + timed + given, [("fu", d.speeds["forcing"])],
+                     "Right-hand side fu(q, u) of the equations in the speeds, Mu ud = fu: V' (f - Mq (V' u + "
+                     "v')) with qd = V u + v" + note + "."),
+        ]
     if d.varying:  # the same equations with parameters made time-varying (Signal.parameter)
         moving = ([("time", [TIME])] if d.time_dependent else []) + [
             ("signals", [s for sig in d.varying["signals"] for s in sig.symbols])]

@@ -41,8 +41,12 @@ def functions(d) -> list[Function]:
     if spin is None:
         return []
     name, rate, _ = spin
+    grad = sp.Matrix([[sp.diff(rate, p) for p in d.model.symbols]])
     return [Function("spin_rate", [("params", d.model.symbols)], [("rate", sp.Matrix([rate]))],
-                     f"The spin rate in rad/s set by the parameter {name}: {rate}.")]
+                     f"The spin rate in rad/s set by the parameter {name}: {rate}."),
+            Function("spin_rate_gradient", [("params", d.model.symbols)], [("grad", grad)],
+                     "The spin rate's derivatives by each parameter, in the parameters' order (the "
+                     "first-order band probability of a tolerance study).", ("grad",))]
 
 
 def metadata(d) -> dict:

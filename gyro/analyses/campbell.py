@@ -139,19 +139,22 @@ def whirl(vec: np.ndarray, freq: np.ndarray, reduced: list, pairs: list) -> np.n
 
 def _tracked_root(model, base, iv, spin, x, target):
     """The root at spin value x nearest to `target` (a tracked root interpolated between two
-    grid points): one set by the default method."""
+    grid points): one set by the default method. Returns (root, spin rate, its index in that
+    set's ascending order: the number `gyro frequencies` gives it there, less one)."""
     P = base.copy()
     P[iv] = x
     s = ladder.spectrum(model, P, "default")
     lam = s.growth[0] + 1j * s.frequencies[0]
     j = int(np.nanargmin(np.abs(lam - target)))
-    return lam[j], float(spin_rates(model, spin, P[None])[0])
+    return lam[j], float(spin_rates(model, spin, P[None])[0]), j
 
 
 def crossings(model: Model, base: np.ndarray, spin: str, values, rate, lam, harmonics) -> list[Crossing]:
     """Where a line k x spin rate meets a tracked mode's damped frequency: each sign change
     of Im(lambda_j) - k rate between grid points, refined by Brent's method on the spin
-    value with the spectrum solved there (not read off the grid)."""
+    value with the spectrum solved there (not read off the grid). The crossing's mode is
+    numbered as `gyro frequencies` numbers it at the crossing's spin (ascending |lambda| of
+    that set), its branch by the tracked column (1-based)."""
     from scipy.optimize import brentq
 
     iv = model.param_names.index(spin)
@@ -165,7 +168,7 @@ def crossings(model: Model, base: np.ndarray, spin: str, values, rate, lam, harm
 
                 def h(x):
                     t = (x - x0) / (x1 - x0)
-                    root, r = _tracked_root(model, base, iv, spin, x, (1 - t) * l0 + t * l1)
+                    root, r, _ = _tracked_root(model, base, iv, spin, x, (1 - t) * l0 + t * l1)
                     return root.imag - k * r
 
                 try:
@@ -174,8 +177,8 @@ def crossings(model: Model, base: np.ndarray, spin: str, values, rate, lam, harm
                 except ValueError:  # the sign change does not survive the exact roots: none
                     continue
                 t = (x - x0) / (x1 - x0)
-                root, r = _tracked_root(model, base, iv, spin, x, (1 - t) * l0 + t * l1)
-                out.append(Crossing(int(k), j + 1, float(x), float(r), float(root.imag)))
+                root, r, at = _tracked_root(model, base, iv, spin, x, (1 - t) * l0 + t * l1)
+                out.append(Crossing(int(k), at + 1, float(x), float(r), float(root.imag), j + 1))
     return sorted(out, key=lambda c: (c.value, c.k, c.mode))
 
 
@@ -211,7 +214,7 @@ def campbell(model: Model, values: dict, spin: str | None, sweep_values, harmoni
         whirl=whirl(vec_t, lam_t.imag, model.meta["reduced"], pairs),
         harmonics=[int(k) for k in harmonics],
         crossings=crossings(model, P[0], spin, x, rate, lam_t, harmonics),
-        rate_label=_rate_label(model, spin), log=log)
+        rate_label=_rate_label(model, spin), log=log, order=order)
 
 
 def _rate_label(model: Model, spin: str) -> str:

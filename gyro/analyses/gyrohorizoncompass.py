@@ -18,7 +18,8 @@ gyro.results.verdict: 'unstable' where a root's disk lies right of the axis, 'bo
 where two disks overlap or a margin lies within its bound of zero (rounding could change
 the answer), 'stable' otherwise (docs/gyrohorizoncompass.md, "Boundaries").
 
-Names: the command line's `lambda` is the model's `lam` (a keyword of C and Python); its
+Names: the paper's `lambda` is the model's `lam` (a keyword of C and Python); every command
+prints `lam` and takes either, and this module works in `lambda` (NAMES). Its
 default is 1 + chi of the given A, B, C, I (3.2). `theta` = (C - A)/I and `chi` = (C - B)/I
 may be map axes: they move A and B with C and I fixed.
 """
@@ -56,8 +57,9 @@ def model():
 
 
 def cli_name(name: str) -> str:
-    """The name a user types for a parameter (the model's aliases: lambda for lam)."""
-    return {v: k for k, v in model().meta.get("aliases", {}).items()}.get(name, name)
+    """This module's name for a parameter named by its declared name or the other name taken
+    for it (the model's aliases: lambda for lam)."""
+    return {v: k for k, v in model().aliases.items()}.get(model().canonical(name), name)
 
 
 def _number(name: str, raw) -> float:
@@ -80,14 +82,17 @@ def parameters(sets: dict | None = None, orbit: bool = False, base: dict | None 
     Raises ParameterError naming the parameter or the reason."""
     sets = dict(sets or {})
     values = dict(model().defaults if base is None else base)
-    given = set()
-    for key, raw in sets.items():
+    given = {}  # this module's name: the name typed
+    for typed, raw in sets.items():
+        key = cli_name(typed)
         if key not in NAMES:
-            raise ParameterError(f"unknown parameter {key!r} for {MODEL}; known: {' '.join(NAMES)}")
+            raise ParameterError(f"unknown parameter {typed!r} for {MODEL}; known: {model().known_names()}")
+        if key in given:
+            raise ParameterError(f"parameter {model().canonical(key)}: given twice (as {given[key]} and {typed})")
         v = _number(key, raw)
         _check(key, v)
         values[model().canonical(key)] = v
-        given.add(key)
+        given[key] = typed
     if orbit:
         for key in ("zeta", "eta"):
             if key in given:
@@ -129,7 +134,8 @@ def with_axis(values: dict, name: str, value: float) -> dict:
 
 
 def cli_params(values: dict) -> dict:
-    return {cli_name(k): float(v) for k, v in values.items()}
+    """The values by the model's declared names (the results add the other names to their JSON)."""
+    return {k: float(v) for k, v in values.items()}
 
 
 # ------------------------------------------------------------------ conditions and spectrum
@@ -270,7 +276,7 @@ def stability(values: dict, orbit: bool = False):
     return EquilibriumStability(
         verdict=str(v.label[0]), boundary_reason=v.reason[0] if v.label[0] in ("boundary", "marginal") else None,
         margin_bounds=bounds, radii=radii,
-        model=MODEL, title=m.meta["title"], params=cli_params(values),
+        model=MODEL, title=m.meta["title"], params=cli_params(values), aliases=m.aliases,
         equilibrium={"alpha": 0.0, "beta": 0.0, "gamma": 0.0, "epsilon0": float(a["epsilon0"][0])},
         theta=float(a["theta"][0]), chi=float(a["chi"][0]), conditions=conditions,
         sufficient=bool(a["sufficient"][0]), orbit=bool(orbit),
@@ -295,8 +301,10 @@ def energy_bound(values: dict) -> float:
 
 
 def parse_axis(flag: str, text: str) -> tuple[str, float, float, int]:
-    """NAME=LO:HI:N over a parameter or theta, chi -> (name, lo, hi, n)."""
-    return grid_axis(flag, text, NAMES + DERIVED, 1000)
+    """NAME=LO:HI:N over a parameter (its declared name or another taken for it) or theta,
+    chi -> (this module's name, lo, hi, n)."""
+    name, lo, hi, n = grid_axis(flag, text, NAMES + DERIVED + tuple(model().aliases.values()), 1000)
+    return cli_name(name), lo, hi, n
 
 
 def condition_map(base: dict, xaxis, yaxis, orbit: bool = False, lambda_follows: bool = True):
@@ -343,11 +351,11 @@ def condition_map(base: dict, xaxis, yaxis, orbit: bool = False, lambda_follows:
         moved.add("lambda")
     if orbit:
         moved |= {"zeta", "eta"}
-    return ConditionMap(model=MODEL, title=m.meta["title"], xname=xn, yname=yn, x=x, y=y,
+    return ConditionMap(model=MODEL, title=m.meta["title"], xname=m.canonical(xn), yname=m.canonical(yn), x=x, y=y,
                         values=values.astype(int), growth=growth, orbit=bool(orbit),
                         boundary=(label == "boundary").reshape(ny, nx),
                         reasons=a["verdict"].reason.reshape(ny, nx),
-                        base={k: v for k, v in cli_params(base).items() if k not in moved})
+                        base={k: v for k, v in cli_params(base).items() if cli_name(k) not in moved})
 
 
 # ------------------------------------------------------------------ motions

@@ -40,8 +40,7 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
     names = q.quantities(model, opts)
     idx = q.requested(model, opts)
     N, nq = P.shape[0], len(names)
-    cands = [lv for lv in hierarchy.levels(model) if lv.answers_question(question)
-             and (among is None or lv.name in among)]
+    cands = candidates(model, q, question, idx, among)
     if not cands:
         from gyro.errors import ParameterError
 
@@ -63,7 +62,9 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
             continue
         pre = B.apriori[:, idx].max(axis=1) if idx else np.zeros(pending.size)
         beyond = B.bad
-        hopeful = ~beyond & (pre <= tol)
+        # a level with a certificate may prove the tolerance itself where its own bound is larger
+        certifying = bool(lv.evaluator.get("certify")) and hasattr(q, "certify")
+        hopeful = ~beyond & ((pre <= tol) | certifying)
         trial.code[pending[beyond]] = EDGE
         if beyond.any():
             trial.say(pending[beyond], B.invalid[beyond])
@@ -73,11 +74,15 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
         if sub.size == 0:
             continue
         ks = pending[sub]
-        ans = q.answer(model, lv, P[ks], q.subset(opts, ks, N) if hasattr(q, "subset") else opts)
+        ans = answer_per_set(q, model, lv, P[ks], q.subset(opts, ks, N) if hasattr(q, "subset") else opts)
         total = hierarchy.Bounds(B.apriori[sub], B.estimate, B.invalid[sub], B.answered, B.bad[sub]).total(ans.estimate)
-        edge = q.edges(model, ans, total, idx, B.answered)
+        failed = ans.failed != ""
+        if certifying:
+            total, edge = proven(q, model, lv, P[ks], ans, total, idx, tol, question)
+        else:
+            edge = q.edges(model, ans, total, idx, B.answered)
         worst = total[:, idx].max(axis=1) if idx else np.zeros(sub.size)
-        failed, crossed = ans.failed != "", edge != ""
+        crossed = edge != ""
         ok = ~failed & ~crossed & (worst <= tol)
         trial.value[ks] = worst
         trial.code[ks] = np.where(ok, ACCEPTED, np.where(failed, FAILED, np.where(crossed, QUESTION_EDGE, BOUND)))
@@ -92,6 +97,97 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
         pending = np.delete(pending, sub[ok])
     return Scene(model.name, question, float(tol), [names[j] for j in idx], level, bound, trials,
                  time.perf_counter() - t0, answers, row)
+
+
+def proven(q, model, lv, P, ans, total, idx, tol, question: str = "frequencies"):
+    """The bound a level's certificate proves per set and requested quantity, and per set
+    the reason where it proves none: its own bound where that is within reach, else tol
+    itself (the certificate proves an interval of any width: a cheap answer whose own bound
+    is pessimistic is taken where it is within tol of the exact model); where its own bound
+    fails the proof, tol is tried. The certificate judges the exact model as evaluated in
+    double precision; with {"certify": {"inputs": LEVEL}} the a-priori part of LEVEL's bound
+    (the rounding of the inputs, u cos(phi) near the pole) separates that from the exact
+    model: a proven c and an input term t make c + t + c t, so c is at most
+    (tol - t)/(1 + t). inf where nothing is proven; the rank of each mode is proven with
+    it, so no neighbour's interval is an edge."""
+    spec = lv.evaluator.get("certify")
+    t = np.zeros(total.shape)
+    if isinstance(spec, dict) and spec.get("inputs"):
+        ref = hierarchy.get(model, spec["inputs"])
+        t = hierarchy.bounds(model, ref, question, P, total.shape[1]).apriori
+        t = np.where(np.isfinite(t), t, np.inf)
+    with np.errstate(invalid="ignore"):
+        room = (tol - t) / (1 + t)
+    claim = np.where(total <= room, total, room)
+    reason = np.full(P.shape[0], "", object)
+    short = ~np.all(room[:, idx] > 0, axis=1) if idx else np.zeros(P.shape[0], bool)
+    reason[short] = "certificate: the rounding of the inputs alone exceeds the tolerance"
+    live = np.flatnonzero((ans.failed == "") & ~short)
+    if live.size and idx:
+        reason[live] = q.certify(model, lv, P[live], ans.take(live), claim[live], idx)
+        again = live[(reason[live] != "") & np.any(claim[live][:, idx] < room[live][:, idx], axis=1)]
+        if again.size:
+            second = q.certify(model, lv, P[again], ans.take(again), room[again], idx)
+            took = again[second == ""]
+            claim[took], reason[took] = room[took], ""
+    out = claim + t + claim * t
+    out[reason != ""] = np.inf
+    return out, reason
+
+
+def candidates(model, q, question: str, idx, among=None) -> list:
+    """The levels that answer `question`, in the order the selector tries them: by their
+    cost with their certificate's for the requested quantities (the question's
+    `certificate_cost`, where it has one), ties in the declared order."""
+    cost = getattr(q, "certificate_cost", lambda lv, idx: 0.0)
+    found = [lv for lv in hierarchy.levels(model) if lv.answers_question(question)
+             and (among is None or lv.name in among)]
+    order = sorted(range(len(found)), key=lambda i: (found[i].cost + cost(found[i], idx), i))
+    return [found[i] for i in order]
+
+
+def answer_per_set(q, model, lv, P, opts):
+    """The level's answer over the batch; where it raises for the batch, set by set, so
+    that a set the level cannot answer (no equilibrium, a block without its roots, a
+    singular solve) fails that set only, with the exception's text as its reason. Bad
+    input (ParameterError) is the caller's, not a set's."""
+    from gyro.errors import ParameterError
+    from gyro.questions import Answer
+
+    try:
+        return q.answer(model, lv, P, opts)
+    except ParameterError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - any failure of a level is that level's, per set
+        if P.shape[0] == 1:
+            n = len(q.quantities(model, opts))
+            text = (str(exc).splitlines() or [""])[0]  # one line: the reason is a table row
+            return Answer(np.full((1, n), np.nan), None, np.array([f"{type(exc).__name__}: {text}"], object), {})
+    N = P.shape[0]
+    sub = (lambda k: q.subset(opts, np.array([k]), N)) if hasattr(q, "subset") else (lambda k: opts)
+    parts = [answer_per_set(q, model, lv, P[k:k + 1], sub(k)) for k in range(N)]
+    return _joined(parts)
+
+
+def _joined(parts):
+    """One Answer from the answers of single sets (a failed set's values NaN, its estimate
+    inf and its other data NaN, shaped like an answered set's)."""
+    from gyro.questions import Answer
+
+    good = [a for a in parts if a.failed[0] == ""]
+    like = good[0] if good else parts[0]
+    values = np.concatenate([a.values if a.values.shape[1:] == like.values.shape[1:]
+                             else np.full((1,) + like.values.shape[1:], np.nan) for a in parts])
+    est = None
+    if any(a.estimate is not None for a in parts):
+        est = np.concatenate([a.estimate if a.estimate is not None else np.full((1,) + values.shape[1:], np.inf)
+                              for a in parts])
+    extra = {}
+    for key, v in like.extra.items():
+        fill = lambda a: (a.extra[key] if key in a.extra and a.extra[key] is not None  # noqa: E731
+                          else np.full((1,) + np.shape(v)[1:], np.nan))
+        extra[key] = None if v is None else np.concatenate([fill(a) for a in parts])
+    return Answer(values, est, np.concatenate([a.failed for a in parts]), extra)
 
 
 def level_error(model, question: str, level: str, against: str, P, opts: dict | None = None):
@@ -111,29 +207,30 @@ def level_error(model, question: str, level: str, against: str, P, opts: dict | 
 
 
 def rungs(model, question: str, P, opts: dict | None = None, until: str | None = None) -> list:
-    """The levels the selector can take for `question` on the sets P, cheapest first: those
-    that answer every requested quantity and are not dominated on P, a level being
-    dominated where a cheaper one's largest bound over the requested quantities is no
-    larger on every set (the quartic level behind the paper operator's blocks: its nutation
-    roots carry the blocks' bound and more). The rungs of the hierarchy's property tests;
-    `until` names the last level looked at (the costlier ones are not run)."""
+    """The levels the selector can take for `question` on the sets P, in its order for this
+    request (`candidates`): those that answer every requested quantity and are not
+    dominated on P, a level being dominated where a cheaper one's largest bound over the
+    requested quantities is no larger on every set. A level with a certificate is never
+    dominated: it may prove the tolerance where its own bound says less. The rungs of the
+    hierarchy's property tests; `until` names the last level looked at (the costlier ones
+    are not run)."""
     opts = dict(opts or {})
     q = questions.get(question)
     P = as_batch(model, P)
     idx = q.requested(model, opts)
     nq = len(q.quantities(model, opts))
     out, worst = [], []
-    for lv in hierarchy.levels(model):
-        if not lv.answers_question(question):
-            continue
+    for lv in candidates(model, q, question, idx):
         B = hierarchy.bounds(model, lv, question, P, nq)
         if not all(B.answered[j] for j in idx):
             continue
+        certifying = bool(lv.evaluator.get("certify")) and hasattr(q, "certify")
         w = B.total(q.answer(model, lv, P, opts).estimate)[:, idx].max(axis=1)
-        if any(np.all(v <= w) for v in worst):
+        if not certifying and any(np.all(v <= w) for v in worst):
             continue
         out.append(lv.name)
-        worst.append(w)
+        if not certifying:
+            worst.append(w)
         if lv.name == until:
             break
     return out

@@ -46,8 +46,7 @@ def spin_parameter(model: Model, name: str | None, sole_rate: bool = False) -> s
             raise ParameterError(f"--spin: {model.name} declares no spin parameter; name one in rad/s "
                                  f"(--spin NAME; parameters: {' '.join(model.param_names)})")
         return declared
-    if name not in model.param_names:
-        raise ParameterError(f"--spin {name!r}: unknown parameter; known: {' '.join(model.param_names)}")
+    name = model.param_name(name, "--spin")
     unit = model.params[model.param_names.index(name)].unit
     if name != declared and unit != "rad/s":
         raise ParameterError(f"--spin {name!r}: its unit is {unit}, not rad/s, and {model.name} declares "

@@ -16,9 +16,10 @@ covariance of the parameters (the copula's correlation carried to uniform margin
 (6/pi) asin(rho/2) between two uniforms, rho sqrt(3/pi) between a normal and a uniform).
 
 The band probability: the chance that omega_i falls within +-band (relative) of a
-harmonic k omega_c of the rotor's spin rate omega_c = H / C (a model with the parameters
-H, the rotor's angular momentum, and C, its polar moment), sampled, and to first order
-from the sensitivities of omega_i - k omega_c."""
+harmonic k omega_c of the spin rate omega_c as the model declares it (Model.spin, the
+emitted spin_rate: H/C, the rotor's angular momentum over its polar moment, for the torsion
+gyrocompass; any model that declares its spin), sampled, and to first order from the
+sensitivities of omega_i - k omega_c."""
 from __future__ import annotations
 
 import tempfile
@@ -102,10 +103,26 @@ def correlation(spreads: list[Spread], pairs: dict) -> np.ndarray:
 
 
 def spin_rate(model: Model, P: np.ndarray) -> np.ndarray | None:
-    """omega_c = H / C per set, or None for a model without both parameters."""
-    if not {"H", "C"} <= set(model.param_names):
+    """The spin rate omega_c in rad/s per set, as the model declares it (Model.spin, the
+    emitted spin_rate: H/C for the torsion gyrocompass), or None for a model that declares
+    no spin."""
+    from gyro.analyses.spin import spin_rates
+
+    declared = model.meta.get("spin", {}).get("parameter")
+    if declared is None:
         return None
-    return P[:, model.param_names.index("H")] / P[:, model.param_names.index("C")]
+    return spin_rates(model, declared, np.atleast_2d(P))
+
+
+def spin_rate_gradient(model: Model, p0: np.ndarray) -> np.ndarray:
+    """d omega_c / d p at the set p0: the emitted derivatives of the declared spin rate."""
+    from gyro.kernels import function
+
+    if "spin_rate_gradient" not in model.meta["functions"]:
+        raise ParameterError(f"--harmonics: {model.name} was emitted without spin_rate_gradient "
+                             "(derive it again with this version)")
+    with np.errstate(all="ignore"):
+        return np.asarray(function(model, "spin_rate_gradient")(np.asarray(p0, float)[None])[0], float).reshape(-1)
 
 
 def samples(nominal, index, relwidth, uniform, chol, seed, start, stop):
@@ -165,20 +182,23 @@ def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: i
     depend on it: the random streams come in blocks of STREAM)."""
     from gyro.analyses.sensitivity import sensitivities
 
+    # by the declared names (another name taken for a parameter, as lambda for lam, too)
+    spreads = [Spread(model.param_name(s.name, "--spread"), s.kind, s.width) for s in spreads]
+    pairs = {(model.canonical(a), model.canonical(b)): rho for (a, b), rho in (pairs or {}).items()}
     names = [s.name for s in spreads]
     if not 2 <= n:
         raise ParameterError(f"--samples: need at least 2 (one sample has no standard deviation), got {n}")
     for s in spreads:
-        if s.name not in model.param_names:
-            raise ParameterError(f"--spread {s.name}: unknown parameter; known: {' '.join(model.param_names)}")
         if values[s.name] == 0:
             raise ParameterError(f"--spread {s.name}: its value is 0, so a relative spread moves nothing")
     if len(set(names)) != len(names):
         raise ParameterError("--spread: a parameter is given twice")
     if harmonics and spin_rate(model, model.vector(values)[None]) is None:
-        raise ParameterError(f"--harmonics: {model.name} has no spin rate H/C (parameters H and C)")
+        raise ParameterError(f"--harmonics: {model.name} declares no spin (Model.spin: the parameter that "
+                             "sets it and its rate): no harmonic k omega_c to fall on")
     if harmonics and not spin_rate(model, model.vector(values)[None])[0] > 0:
-        raise ParameterError("--harmonics: the rotor does not spin (H = 0): no harmonic k omega_c to fall on")
+        raise ParameterError(f"--harmonics: the rotor does not spin at this set ({model.meta['spin']['parameter']} "
+                             "gives a spin rate of 0): no harmonic k omega_c to fall on")
     corr = correlation(spreads, pairs or {})
     chol = np.linalg.cholesky(corr)
     nominal = model.vector(values)
@@ -258,10 +278,8 @@ def _bands(F, ok, spin, harmonics, band, nominal_freq, dfreq, model, nominal, co
     first-order one (a normal omega_i - k omega_c)."""
     from scipy.special import ndtr
 
-    iH, iC = model.param_names.index("H"), model.param_names.index("C")
-    wc0 = nominal[iH] / nominal[iC]
-    dwc = np.zeros(len(nominal))
-    dwc[iH], dwc[iC] = 1 / nominal[iC], -nominal[iH] / nominal[iC] ** 2
+    wc0 = float(spin_rate(model, np.asarray(nominal, float)[None])[0])
+    dwc = spin_rate_gradient(model, np.asarray(nominal, float))
     out = []
     n_ok = max(int(ok.sum()), 1)
     for i in range(F.shape[1]):

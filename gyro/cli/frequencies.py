@@ -26,6 +26,8 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    import numpy as np
+
     from gyro import ladder
 
     model = model_with_equilibrium(args.model)
@@ -35,6 +37,12 @@ def run(args) -> int:
     if args.modes and args.method == "formulas":
         raise ParameterError("--modes: the formulas give frequencies only; use another --method")
     spec = ladder.spectrum(model, model.vector(values), args.method, modes=args.modes)
+    if spec.equilibrium is not None and not np.all(np.isfinite(spec.equilibrium[0])):
+        from gyro.equilibrium import EquilibriumError, unbalanced
+
+        reason = unbalanced(model, model.vector(values))
+        if reason:  # no equilibrium: one line naming the residual
+            raise EquilibriumError(reason)
     ladder.require_finite(model, spec)  # no verdict: exit 1, text and JSON alike
     sens = None
     if getattr(args, "sensitivities", False):

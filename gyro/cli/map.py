@@ -24,7 +24,7 @@ def register(sub) -> None:
     add_model(s, MODELS, help="the model")
     s.add_argument("--x", required=True, metavar="NAME=LO:HI:N", help="x axis: a parameter, theta or chi")
     s.add_argument("--y", required=True, metavar="NAME=LO:HI:N", help="y axis: a parameter, theta or chi")
-    add_set(s, "the other parameters (A B C J L I nu zeta eta lambda, SI); default: the Earth set")
+    add_set(s, "the other parameters (A B C J L I nu zeta eta lam (or lambda), SI); default: the Earth set")
     s.add_argument("--orbit", action="store_true", help="zeta = nu, eta = 0 at every point; (4.3) as the condition")
     add_out(s, help="the map as PNG")
     add_json(s)
@@ -34,12 +34,12 @@ def register(sub) -> None:
 def run(args) -> int:
     if args.model not in MODELS:
         raise ParameterError(f"map: unknown model {args.model!r}; it covers {', '.join(MODELS)}")
-    from gyro.analyses.gyrohorizoncompass import condition_map, parameters, parse_axis
+    from gyro.analyses.gyrohorizoncompass import cli_name, condition_map, parameters, parse_axis
 
     xaxis, yaxis = parse_axis("--x", args.x), parse_axis("--y", args.y)
     if args.orbit and {xaxis[0], yaxis[0]} & {"zeta", "eta"}:
         raise ParameterError("--orbit sets zeta = nu and eta = 0: neither can be an axis")
-    sets = parse_sets(args.set)
+    sets = {cli_name(k): v for k, v in parse_sets(args.set).items()}  # lam or lambda: one parameter
     for axis in (xaxis, yaxis):
         if axis[0] in sets:
             raise ParameterError(f"parameter {axis[0]}: is an axis; do not --set it")

@@ -19,6 +19,8 @@ def run(args) -> int:
     print(f"{'name':<8} {'default':>14} {'unit':<10} description")
     for p in model.params:
         print(f"{p.name:<8} {p.default:>14.8g} {p.unit:<10} {p.description}")
+    if model.aliases:  # every command prints the name above and takes these for it too
+        print("also taken: " + ", ".join(f"{a} for {n}" for a, n in model.aliases.items()))
     if model.name == "gimbal_gyroscope":  # a motion's initial conditions, for gyro simulate
         from gyro.analyses.gimbal import INITIAL
 

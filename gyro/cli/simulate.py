@@ -7,7 +7,7 @@ D1,D2,D3,D4] [--method NAME] [--json] [--out FILE.png]`: a motion of the gyrohor
 from its relative equilibrium (3.1), the angles alpha, beta, gamma, epsilon moved by D1..D4
 rad (at rest), by integrating the emitted (1.5)-(1.6) (default DOP853; `projected`: fixed
 steps of DOP853's tableau projected onto E = E(0)); E (2.3) along it. Parameters:
-A B C J L I nu zeta eta lambda (lambda defaults to 1 + chi).
+A B C J L I nu zeta eta lam (or lambda; it defaults to 1 + chi).
 
 `gyro simulate gimbal_precession --level {full,rigorous,image,small,elementary} --t-end T
 [--points N] [--set NAME=VALUE]... [--base-rate NAME=AMP:FREQ[:PHASE]]... [--json] [--out
@@ -16,6 +16,15 @@ FILE.png]`: the image point and the gimbal angles by one level of the precession
 u_eta(t) = u_eta + AMP sin(FREQ t + PHASE) (rad/s, rad/s, rad; NAME xi, eta or zeta;
 repeated, the terms add). JSON keys: model, level, params, t, x, y, alpha, beta (and H,
 seconds, and base_rate for a time-varying base).
+
+`gyro simulate MODEL [--set NAME=VALUE]... --t-end T [--points N] [--perturb NAME=VALUE]...
+[--method NAME] [--json] [--out FILE.png]` for every other model (a generated one, a model
+file, an emitted folder): the emitted nonlinear equations integrated from the reference (the
+equilibrium of the set; steady and cyclic rates as the reference has them), each
+`--perturb NAME=VALUE` an offset of a coordinate or, as NAME_d, of its rate (repeatable);
+methods DOP853 (default), RK45, Radau, BDF, LSODA; JSON keys t, one list per coordinate
+(absolute values, the model's units), method, and rates, coordinates, units, params,
+perturb, equilibrium, model, seconds (gyro/analyses/motion.py).
 
 Parameters: the model's (`gyro params gimbal_gyroscope`) and the initial conditions
 theta0 dtheta0 dpsi0 dphi0 (rad, rad/s); psi(0) = phi(0) = 0. Every input is checked before
@@ -26,7 +35,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from gyro.cli.common import add_json, add_out, add_set, check_png_out, parse_sets
+from gyro.cli.common import add_json, add_model, add_out, add_set, check_png_out, parse_sets
 from gyro.errors import ParameterError, finite_number
 
 ORDER = 50
@@ -35,17 +44,20 @@ SIMULATED = ("gimbal_gyroscope", "gyrohorizoncompass", "gimbal_precession")
 
 
 def register(sub) -> None:
-    s = sub.add_parser("simulate", help="a motion of the gimbal gyroscope (closed form or integrator) "
-                       "or of the gyrohorizoncompass (integrator)")
-    s.add_argument("model")
+    s = sub.add_parser("simulate", help="a motion of a model from its reference (the emitted nonlinear "
+                       "equations integrated; the gimbal gyroscope also by its closed form, gimbal_precession "
+                       "by its levels)")
+    add_model(s)
     add_set(s, "parameter or, for the gimbal, initial condition (theta0 dtheta0 dpsi0 dphi0), SI units, radians")
     s.add_argument("--t-end", required=True, metavar="T", help="end time in s (> 0)")
     s.add_argument("--points", default="1001", metavar="N", help="number of time points from 0 to T (>= 2)")
     s.add_argument("--method", default=None, metavar="NAME",
                    help="closed_form (the gimbal's default), RK45, DOP853 (the gyrohorizoncompass's default), "
                    "Radau, BDF, LSODA, cvodes, idas (gimbal) or cvodes-adams, projected (gyrohorizoncompass)")
-    s.add_argument("--perturb", default=None, metavar="D1,D2,D3,D4",
-                   help="gyrohorizoncompass: alpha, beta, gamma, epsilon - epsilon0 at t = 0, rad (default 0,0,0,0)")
+    s.add_argument("--perturb", action="append", default=None, metavar="NAME=VALUE",
+                   help="an offset at t = 0 from the reference: a coordinate NAME or its rate NAME_d, in the "
+                   "model's units (repeatable); the gyrohorizoncompass also takes D1,D2,D3,D4 (alpha, beta, "
+                   "gamma, epsilon - epsilon0, rad)")
     s.add_argument("--level", default=None, metavar="LEVEL",
                    help="gimbal_precession: full, rigorous, image, small or elementary (required)")
     s.add_argument("--base-rate", action="append", default=None, metavar="NAME=AMP:FREQ[:PHASE]",
@@ -68,8 +80,6 @@ def parse(args):
     from gyro.analyses.gimbal import METHODS, Motion
     from gyro.models import load
 
-    if args.model not in SIMULATED:
-        raise ParameterError(f"simulate: unknown model {args.model!r}; it covers {', '.join(SIMULATED)}")
     if args.perturb is not None:
         raise ParameterError("--perturb: only for gyrohorizoncompass (the gimbal takes --set theta0=...)")
     if args.method is None:
@@ -77,10 +87,11 @@ def parse(args):
     model = load(args.model)
     ic = {p.name: p for p in _initial_params()}
     sets = parse_sets(args.set)
-    known = [*model.param_names, *ic]
+    known = [*model.param_names, *model.aliases, *ic]
     for key in sets:
         if key not in known:
-            raise ParameterError(f"unknown parameter {key!r} for {model.name}; known: {' '.join(known)}")
+            raise ParameterError(f"unknown parameter {key!r} for {model.name}; known: {model.known_names()} "
+                                 f"{' '.join(ic)}")
     values = model.parameters({k: v for k, v in sets.items() if k not in ic})
     init = {}
     for name, p in ic.items():
@@ -121,8 +132,15 @@ def _run_ghc(args) -> int:
 
     values = ghc.parameters(parse_sets(args.set))
     perturb = [0.0] * 4
-    if args.perturb is not None:
-        parts = args.perturb.split(",")
+    if args.perturb is not None and (len(args.perturb) > 1 or "=" in args.perturb[0]):
+        names = ("alpha", "beta", "gamma", "epsilon")
+        for name, raw in _perturb_items(args.perturb).items():
+            if name not in names:
+                raise ParameterError(f"--perturb {name}: the gyrohorizoncompass's offsets are of "
+                                     f"{', '.join(names)} (rad, at rest)")
+            perturb[names.index(name)] = finite_number(f"--perturb {name}", raw)
+    elif args.perturb is not None:
+        parts = args.perturb[0].split(",")
         if len(parts) != 4:
             raise ParameterError(f"--perturb: expected four numbers D1,D2,D3,D4, got {args.perturb!r}")
         perturb = [finite_number(f"--perturb {n}", p) for n, p in zip(("alpha", "beta", "gamma", "epsilon"), parts)]
@@ -163,6 +181,44 @@ def _run_precession(args) -> int:
     return 0
 
 
+def _perturb_items(items: list) -> dict:
+    """--perturb NAME=VALUE items as {name: text}, each name once."""
+    out = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise ParameterError(f"--perturb {item!r}: expected NAME=VALUE (a coordinate, or its rate NAME_d)")
+        if name in out:
+            raise ParameterError(f"--perturb {name}: given twice")
+        out[name] = value.strip()
+    return out
+
+
+def _run_generic(args) -> int:
+    """Any other model: every input checked first (names, numbers, --perturb, --t-end,
+    --points, --method, --out), then integrated from the reference."""
+    from gyro.analyses import motion
+    from gyro.models import load
+
+    for flag, what in (("level", "--level"), ("base_rate", "--base-rate")):
+        if getattr(args, flag) is not None:
+            raise ParameterError(f"{what}: only for gimbal_precession")
+    model = load(args.model)
+    values = model.parameters(parse_sets(args.set))
+    offsets = motion.perturbations(model, _perturb_items(args.perturb or []))
+    t = _times(args)
+    method = args.method or "DOP853"
+    if method not in motion.METHODS:
+        raise ParameterError(f"--method: unknown method {method!r}; known: {' '.join(motion.METHODS)}")
+    out = check_png_out(args.out) if args.out is not None else None
+    m = motion.simulate(model, values, offsets, t, method)
+    if out is not None:
+        m.plot(out)
+    print(json.dumps(m.to_dict(), allow_nan=False) if args.json else m.table())
+    return 0
+
+
 def _oscillation(item: str):
     """One --base-rate NAME=AMP:FREQ[:PHASE] as an Oscillation, or ParameterError naming it."""
     from gyro.analyses import precession
@@ -180,6 +236,8 @@ def run(args) -> int:
 
     from gyro.analyses.gimbal import trajectory
 
+    if args.model not in SIMULATED:
+        return _run_generic(args)
     if args.base_rate is not None and args.model != "gimbal_precession":
         raise ParameterError("--base-rate: only for gimbal_precession")
     if args.model == "gyrohorizoncompass":

@@ -4,7 +4,7 @@ circular orbit, --orbit: zeta = nu, eta = 0) and of C1's Sylvester minors, and t
 of the linearisation (companion eigensolve of the emitted operator), with the verdict:
 `boundary` (and `boundary_reason`, one line) where rounding could change it.
 
-Parameters: A B C J L I nu zeta eta lambda (SI; lambda defaults to 1 + chi). Bad input, or a
+Parameters: A B C J L I nu zeta eta lam (SI; lambda is taken for lam; it defaults to 1 + chi). Bad input, or a
 set without a relative equilibrium, exits with 2 and one line naming the parameter or the
 reason.
 """
@@ -22,7 +22,7 @@ MODELS = ("gyrohorizoncompass",)
 def register(sub) -> None:
     s = sub.add_parser("stability", help="gyrohorizoncompass: conditions (3.6)/(4.3) against the spectrum")
     add_model(s, MODELS, help="the model")
-    add_set(s, "A B C J L I nu zeta eta lambda, SI units (lambda defaults to 1 + chi)")
+    add_set(s, "A B C J L I nu zeta eta lam (or lambda), SI units (lam defaults to 1 + chi)")
     s.add_argument("--orbit", action="store_true", help="a satellite on a circular orbit: zeta = nu, eta = 0 (4.1)")
     add_json(s)
     s.set_defaults(run=run)

@@ -41,10 +41,9 @@ def run(args) -> int:
 
     model = model_with_equilibrium(args.model)
     values = model.parameters(parse_sets(args.set))
+    args.x, args.y = model.param_name(args.x, "--x"), model.param_name(args.y, "--y")  # declared names
     for axis, name, (lo, hi), log in (("--x", args.x, args.x_range, args.x_log),
                                       ("--y", args.y, args.y_range, args.y_log)):
-        if name not in model.param_names:
-            raise ParameterError(f"{axis} {name!r}: unknown parameter; known: {' '.join(model.param_names)}")
         if not lo < hi or not (math.isfinite(lo) and math.isfinite(hi)):
             raise ParameterError(f"{axis}-range: need finite LO < HI, got {lo} {hi}")
         if log and not lo > 0:

@@ -34,12 +34,10 @@ def run(args) -> int:
     import numpy as np
 
     from gyro.analyses.sweep import sweep
-    from gyro.results._io import cell
 
     model = model_with_equilibrium(args.model)
     values = model.parameters(parse_sets(args.set))
-    if args.x not in model.param_names:
-        raise ParameterError(f"--x {args.x!r}: unknown parameter; known: {' '.join(model.param_names)}")
+    args.x = model.param_name(args.x, "--x")  # the declared name (another name taken for it too)
     lo, hi = args.x_range
     if not lo < hi or not (math.isfinite(lo) and math.isfinite(hi)):
         raise ParameterError(f"--x-range: need finite LO < HI, got {lo} {hi}")
@@ -65,11 +63,8 @@ def run(args) -> int:
     elif out is not None:
         print(result.summary(out))
     else:
-        f = result.spectrum.frequencies
-        print(f"{'':>4} {args.x + ' [' + result.xunit + ']':>16} " + " ".join(f"{'omega' + str(j + 1):>12}" for j in range(f.shape[1])))
-        for i, xv in enumerate(result.x):
-            print(f"{i + 1:>4} {xv:>16.8g} " + " ".join(cell(w, ">12.6g") for w in f[i]))
+        print(result.table())
     if not np.all(np.isfinite(result.spectrum.frequencies)):
-        print("gyro: some values have no finite spectrum (none above)", file=sys.stderr)
+        print("gyro: some values have no finite spectrum (failed above)", file=sys.stderr)
         return 1
     return 0

@@ -27,7 +27,7 @@ def register(sub) -> None:
     t.add_argument("--correlate", action="append", default=[], metavar="A,B=RHO",
                    help="correlation of two spread parameters (a Gaussian copula); repeat as needed")
     t.add_argument("--harmonics", default=None, metavar="K,...",
-                   help="probability that a frequency falls within --band of k omega_c, omega_c = H/C the spin rate")
+                   help="probability that a frequency falls within --band of k omega_c, omega_c the spin rate the model declares (Model.spin; H/C for the torsion gyrocompass)")
     t.add_argument("--band", type=float, default=0.02, metavar="REL", help="half-width of the band, relative (default: 0.02)")
     add_scheduler(t)
     t.add_argument("--store", default=None, metavar="DIR",

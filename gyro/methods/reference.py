@@ -7,7 +7,7 @@ import mpmath
 import numpy as np
 
 from gyro import qep
-from gyro.equilibrium import EquilibriumError, equilibria
+from gyro.equilibrium import EquilibriumError, equilibria_reported, why_not
 from gyro.models import Model
 from gyro.results import Spectrum
 
@@ -23,6 +23,8 @@ def _mp_equilibrium(mf, p, q0, idx, max_iter=60):
     beta = 5e-20 at (3.1), where its steps stay at the rounding of the others' residual),
     where the largest step is within tol of the largest coordinate and no longer shrinks."""
     q = [mpmath.mpf(v) for v in q0]
+    if not idx:  # no equilibrium coordinates (a rotor centred by its bearings): nothing to solve
+        return q
     tol = mpmath.mpf(10) ** (-mpmath.mp.dps + 5)
     last = None
     for _ in range(max_iter):
@@ -81,18 +83,22 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None, dps: int = DPS)
     """Arbitrary precision: the equilibrium by Newton from the double one, the companion
     eigenvalues by mpmath.eig, each root polished by Newton on det J (trace of J^-1 J').
     The estimate is the last Newton step, floored at 10^(5 - dps), plus the effect of the
-    inputs' rounding in this precision where a root lies far below the others."""
+    inputs' rounding in this precision where a root lies far below the others, plus, for a
+    root within 1e-6 of another (qep.cluster_rounding), the effect of rounding the decimal
+    inputs to doubles (4 eps), which moves a colliding pair by its square root. A model
+    without equilibrium coordinates (a rotor centred by its bearings) solves no equilibrium;
+    a set without one is refused in one line naming the equation's residual."""
     mf = model.mpmath
     reduced = model.meta["reduced"]
     idx = [reduced.index(c) for c in model.meta["equilibrium_coordinates"]]
     N = P.shape[0]
-    qe_d, ok = equilibria(model, P)
+    qe_d, ok, report = equilibria_reported(model, P)
     out = None
     with mpmath.workdps(dps):
         for k in range(N):
             p = [mpmath.mpf(float(v)) for v in P[k]]
             if not ok[k]:  # equilibria() has tried the set-by-set solver as well
-                raise EquilibriumError(f"no equilibrium in double precision to start from (set {k})")
+                raise EquilibriumError((f"set {k}: " if N > 1 else "") + why_not(model, report, k))
             start = qe_d[k]
             roots, steps, q = _reference_roots(mf, p, start, idx)
             n = len(roots)
@@ -107,6 +113,13 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None, dps: int = DPS)
                 return [complex(r) for r in _reference_roots(mf, moved, start, idx)[0]]
 
             est = est + qep.input_rounding(model, P[k], lam, solve_moved)
+
+            def solve_at(Pp, start=start):  # inputs moved in double precision
+                return [complex(r) for r in _reference_roots(mf, [mpmath.mpf(float(v)) for v in Pp], start, idx)[0]]
+
+            # a cluster of roots (a collision) moves with the rounding of the decimal inputs by
+            # its square root, which the given doubles do not show
+            est = est + qep.cluster_rounding(P[k], lam, solve_at)
             out[0][k], out[1][k], out[2][k] = np.abs(lam.imag), lam.real, est
             out[3][k] = [float(v) for v in q]
     f, g, e = qep.sort_spectrum(out[0], out[1], out[2])

@@ -18,7 +18,12 @@ A question module has NAME (the command line's name) and:
 - optionally `subset(opts, rows, n) -> opts`: the options for the sets `rows` of a batch
   of n, where an option is given per set (the motion's initial conditions);
 - optionally VALUES: the key of `document` holding the per-quantity answer, which the
-  scene's table shows beside each quantity's bound.
+  scene's table shows beside each quantity's bound;
+- optionally `certify(model, level, P, answer, bound, idx) -> array of str` and
+  `certificate_cost(level, idx) -> s`: for a level whose evaluator says "certify", the
+  proof of each set's answer within `bound` against the exact model ('' where proven, the
+  reason otherwise) and its cost per set, which the selector adds to the level's in its
+  order (gyro.analyses.scene.proven, candidates).
 
 `names()` reads NAME from the sources (no NumPy); `get(name)` imports one.
 """

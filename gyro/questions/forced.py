@@ -31,6 +31,7 @@ NAME = "forced"
 VALUES = "amplitudes"  # the JSON key of the per-quantity answer (the scene table shows it)
 SAFETY = 2.0  # the linear level's estimate: this many times harmonic balance's first step
 ESTIMATE_NONLINEAR = 1e-8  # harmonic balance against the shooting: 4.4e-9 at most, measured
+EPS = np.finfo(float).eps
 
 
 def quantities(model, opts) -> list[str]:
@@ -71,7 +72,8 @@ def answer(model, level, P, opts) -> Answer:
                 # per coordinate the largest step of its unit group: a small coordinate's own
                 # step can fall short of its error where the response is strongly nonlinear
                 # (x3 at 9 % near a resonance), the group's does not (bench/forced_levels.py)
-                est[j] = SAFETY * np.array([step[info["group"] == g].max() for g in info["group"]]) + 1e-15
+                est[j] = (SAFETY * np.array([step[info["group"] == g].max() for g in info["group"]])
+                          + solve_rounding(model, P[j], info["frequency"], Xl, info["group"]))
             else:
                 Xn, Xl, info = forced.harmonic_balance(model, values, (s, k, a, phi))
                 X[j] = Xn
@@ -84,6 +86,31 @@ def answer(model, level, P, opts) -> Answer:
         if not (np.all(np.isfinite(Xl)) and np.all(np.isfinite(X[j]))):
             failed[j] = "a resonance: the linear response is unbounded"
     return Answer(np.abs(X), est, failed, {"X": X, "scale": scale, "frequency": freq})
+
+
+def solve_rounding(model, p, w, X, group) -> np.ndarray:
+    """Per coordinate, the rounding of the linear response X = J(i w)^-1 B u over its unit
+    group's scale: the solve of the scaled J_s = S J S (gyro.analyses.harmonic.solve_batch)
+    is backward stable, and its forming rounds each entry by eps of its size, so that
+    |dY| <= 4 n eps kappa(J_s) |Y| for Y = S^-1 X, and |dX_i| <= s_i |dY|. Near a resonance
+    kappa grows as the inverse of the relative distance to it (the floor of 1e-15 alone was
+    beaten there: 7e-12 at 1e-5 from the radial resonance)."""
+    from gyro.analyses.harmonic import dynamic_stiffness
+    from gyro.equilibrium import equilibria, operators
+
+    P = p[None, :]
+    M, D, K = operators(model, P, equilibria(model, P)[0])
+    n = M.shape[-1]
+    diag = lambda A: np.abs(np.einsum("sii->si", A))  # noqa: E731
+    with np.errstate(all="ignore"):
+        sc = 1 / np.sqrt(diag(K) + w**2 * diag(M) + w * diag(D))[0]
+        Js = dynamic_stiffness(M, D, K, np.array([w]))[0] * sc[:, None] * sc[None, :]
+        if not np.all(np.isfinite(Js)):
+            return np.full(n, np.inf)
+        kappa = np.linalg.cond(Js)
+        dY = 4 * n * EPS * kappa * np.linalg.norm(X / sc)
+        out = sc * dY / group
+    return np.where(np.isfinite(out), out, np.inf) + 1e-15
 
 
 def edges(model, ans: Answer, bound: np.ndarray, idx, answered) -> np.ndarray:

@@ -13,7 +13,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from gyro.kernels import chunks
 from gyro.questions import Answer, unknown_kind
+
+EPS = np.finfo(float).eps
 
 NAME = "frequencies"
 VALUES = "frequencies"  # the JSON key of the per-quantity answer (the scene table shows it)
@@ -188,7 +191,11 @@ def answer(model, level, P, opts) -> Answer:
     kind = level.evaluator.get("kind")
     if kind not in EVALUATORS:
         raise unknown_kind(NAME, level)
-    return EVALUATORS[kind](model, level, P)
+    ans = EVALUATORS[kind](model, level, P)
+    if level.evaluator.get("certify"):  # each requested rank is proven by the counts: another mode's
+        idx = requested(model, opts)  # missing value leaves the requested ones answered
+        ans.failed[np.all(np.isfinite(ans.values[:, idx]), axis=1)] = ""
+    return ans
 
 
 def edges(model, ans: Answer, bound: np.ndarray, idx, answered) -> np.ndarray:
@@ -223,6 +230,153 @@ def _say(out: np.ndarray, flags: np.ndarray, text) -> None:
     if rows.size:
         j = np.argmax(flags[rows], axis=1)
         out[rows] = np.array([text(i) for i in range(flags.shape[1])], dtype=object)[j]
+
+
+# s per set on one core, on the scale of the methods' COST (linear_exact:default 3.6e-5 s):
+# a count (the compiled Bunch-Kaufman inertia, counts_at) and the rest of a certificate
+# (the equilibrium, the operator, the bookkeeping), from one run of
+# `python -m bench.levels --random-speed` (levels.json 'random_speed': one mode's certificate
+# 0.72x the default method's time, ten modes' 3.0x..4.2x). So the certificate leaves a cheap level
+# its advantage for one or two requested modes, and costs more than it for three and more
+COUNT_COST = 4.1e-6
+OPERATOR_COST = 8.7e-6
+
+
+def certificate_cost(level, idx) -> float:
+    """The certificate's seconds per set for the requested modes idx (0 for a level that
+    declares none): the operator, the count at 0 (K > 0) and two per requested mode."""
+    if not level.evaluator.get("certify"):
+        return 0.0
+    return OPERATOR_COST + COUNT_COST * (1 + 2 * len(idx))
+
+
+def counts_below(M, D, K, w) -> np.ndarray:
+    """Per set, the number of the exact operator's frequencies below w, proven, or -1 where
+    the count cannot be proven in double precision.
+
+    For a conservative gyroscopic operator (M > 0, K > 0 symmetric, D skew) the roots are
+    lambda = +-i omega and Q(w) = J(i w) = K - w^2 M + i w D is Hermitian. Each eigenvalue
+    mu(w) of Q vanishes where w is a frequency, and there dmu/dw = x* Q'(w) x / x* x =
+    (-2 w x*Mx + i x*Dx)/|x|^2 = -(w x*Mx + x*Kx / w)/|x|^2 < 0 (x*Q(w)x = 0 gives
+    i x*Dx = (w^2 x*Mx - x*Kx)/w): every crossing of zero is from + to -, and Q(0) = K > 0
+    has none negative. So the number of negative eigenvalues of Q(w) is the number of
+    frequencies in (0, w), multiplicities counted. The eigenvalues are LAPACK's of the
+    diagonally scaled S Q S (Sylvester: the same inertia): backward stable, each within
+    8 n eps ||SQS||_F of an eigenvalue of the matrix as formed, whose entries are within 64
+    eps of their magnitude |K| + w^2 |M| + w |D| of the operator's (its forming and the
+    evaluation of the operator); a count is proven where no eigenvalue is within the sum
+    of the two of zero (Weyl)."""
+    n = M.shape[-1]
+    w = np.asarray(w, dtype=float)[:, None, None]
+    with np.errstate(all="ignore"):
+        s = 1 / np.sqrt(np.abs(np.einsum("bii->bi", K)) + w[:, :, 0] ** 2 * np.einsum("bii->bi", M))
+        S = s[:, :, None] * s[:, None, :]
+        Q = (K - w**2 * M + 1j * w * D) * S
+        mag = (np.abs(K) + w**2 * np.abs(M) + w * np.abs(D)) * S
+        good = np.all(np.isfinite(Q), axis=(1, 2)) & np.all(np.isfinite(mag), axis=(1, 2))
+        Q[~good] = np.eye(n)
+        mu = np.linalg.eigvalsh(Q)
+        margin = (8 * n * EPS * np.sqrt(np.sum(Q.real**2 + Q.imag**2, axis=(1, 2)))
+                  + 64 * EPS * np.sqrt(np.sum(mag**2, axis=(1, 2))))
+        proven = good & (np.min(np.abs(mu), axis=1) > margin)
+    return np.where(proven, np.sum(mu < 0, axis=1), -1)
+
+
+NOT_GYROSCOPIC = -2  # counts_at: M or K not symmetric, or D not skew, to the bit (no count)
+
+
+def counts_at(M, D, K, W) -> np.ndarray:
+    """counts_below at the points W (sets, points) of each set: the compiled twin
+    (gyro/questions/inertia.c: Bunch-Kaufman's LDL^H of the same scaled matrix, its inertia
+    that of the blocks, proven by the factorization's backward error against the smallest
+    block over ||L^-1||_F^2) where a compiler is at hand, else LAPACK's eigenvalues in NumPy.
+    -> (sets, points), -1 where not proven, NOT_GYROSCOPIC for every point of a set whose
+    operator is not conservative gyroscopic (bearing damping)."""
+    from gyro import cbackend
+    from gyro.qep import gyroscopic
+
+    N, Pn = W.shape
+    try:
+        fn = _inertia_kernel()
+    except cbackend.CompilerUnavailable:
+        c = np.empty(W.shape, int)
+        for s in chunks(N, max(1, 8192 // max(Pn, 1))):  # bounded memory: a matrix per count
+            rep = lambda X: np.repeat(X[s], Pn, axis=0)  # noqa: E731
+            c[s] = counts_below(rep(M), rep(D), rep(K), W[s].reshape(-1)).reshape(-1, Pn)
+        c[~gyroscopic(M, D, K)] = NOT_GYROSCOPIC
+        return c
+    import ctypes
+
+    arrs = [np.ascontiguousarray(X, dtype=float) for X in (M, D, K, W)]
+    out = np.empty(W.shape)
+    ptr = ctypes.POINTER(ctypes.c_double)
+    fn(ctypes.c_long(N), ctypes.c_long(M.shape[-1]), ctypes.c_long(Pn),
+       *[a.ctypes.data_as(ptr) for a in arrs + [out]])
+    c = out.astype(int)
+    # the factorization's bound is the weaker near a frequency (1.4 % of the points at a
+    # relative 1e-7 from one, where LAPACK's eigenvalues prove all): those again in NumPy
+    k, p = np.nonzero((c == -1) & np.isfinite(W) & (W >= 0))
+    if k.size:
+        c[k, p] = counts_below(M[k], D[k], K[k], W[k, p])
+    return c
+
+
+def _inertia_kernel():
+    """The compiled count (gyro/questions/inertia.c, built once per machine as a model's C
+    is); CompilerUnavailable where there is none, or within cbackend.disabled()."""
+    from pathlib import Path
+
+    from gyro import cbackend
+
+    cbackend._available()
+    fn = cbackend._library(str(Path(__file__).parent), "inertia").gyro_inertia_counts
+    fn.restype = None
+    return fn
+
+
+def certify(model, level, P, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
+    """'' per set where every requested mode j is proven to be the exact operator's j-th
+    frequency within its bound b (|f - omega_j| <= b omega_j: omega_j in [f/(1+b),
+    f/(1-b)]), the reason otherwise: counts_below at both ends of the interval prove that
+    omega_j lies in it (at most j - 1 frequencies below its lower end, at least j below its
+    upper one), which proves its value and its rank together. Where the count cannot be
+    evaluated (no equilibrium, bearing damping, K not positive definite, a count not
+    resolved in double precision, b >= 1), the set is not answered by the level."""
+    from gyro.equilibrium import equilibria, operators
+
+    N = P.shape[0]
+    out = np.full(N, "", object)
+    qe, ok = equilibria(model, P)
+    out[~ok] = "certificate: no equilibrium to count the exact operator's frequencies at"
+    live = np.flatnonzero(ok)
+    if live.size == 0:
+        return out
+    every = live.size == N  # no copies of the batch's operators where every set has its equilibrium
+    M, D, K = operators(model, P if every else P[live], qe if every else qe[live])
+    f = ans.values if every else ans.values[live]
+    b = bound if every else bound[live]
+    W = np.zeros((live.size, 1 + 2 * len(idx)))
+    with np.errstate(all="ignore"):
+        for i, j in enumerate(idx):
+            informative = np.isfinite(b[:, j]) & (b[:, j] < 1) & np.isfinite(f[:, j]) & (f[:, j] > 0)
+            W[:, 1 + 2 * i] = np.where(informative, f[:, j] / (1 + b[:, j]), -1.0)
+            W[:, 2 + 2 * i] = np.where(informative, f[:, j] / (1 - b[:, j]), -1.0)
+    c = counts_at(M, D, K, W)
+    c[W < 0] = -1
+    reason = np.full(live.size, "", object)
+    reason[c[:, 0] == NOT_GYROSCOPIC] = "certificate: the operator is not conservative gyroscopic (damping): no count"
+    reason[(c[:, 0] != 0) & (reason == "")] = "certificate: K not proven positive definite (no count of the frequencies)"
+    for i, j in enumerate(idx):
+        lo, hi = c[:, 1 + 2 * i], c[:, 2 + 2 * i]
+        unproven = (lo < 0) | (hi < 0)
+        wrong = ~unproven & ((lo > j) | (hi < j + 1))
+        todo = reason == ""
+        reason[todo & unproven] = (f"certificate: mode {j + 1}'s interval not resolved by a count in double "
+                                   "precision (or its bound >= 1)")
+        reason[todo & wrong] = (f"certificate: the exact omega{j + 1} is not within the bound of this "
+                                "answer (a count of the exact operator's frequencies)")
+    out[live] = reason
+    return out
 
 
 def error(ans: Answer, ref: Answer) -> np.ndarray:

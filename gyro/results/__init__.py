@@ -8,7 +8,8 @@ One module per kind of result; every name is importable from `gyro.results`.
 - `campbell`: `CampbellDiagram` (frequencies against spin, formulas overlaid);
 - `stability_map`: `StabilityMap` (stability of the equilibrium over two parameters);
 - `sweep`: `FrequencySweep` (frequencies against any one parameter);
-- `trajectory`: `Trajectory` (the gimbal's motion: closed form or an integrator);
+- `trajectory`: `Trajectory` (the gimbal's motion: closed form or an integrator), `CoordinateMotion`
+  (any model's motion from its reference, gyro/analyses/motion.py);
 - `gyrohorizoncompass`: `EquilibriumStability`, `ConditionMap`, `AngleTrajectory`;
 - `verdict`: `Verdict`, the one verdict type (stable, marginal, unstable, boundary,
   unknown, failed, each with its reason) and the two tests every analysis reads it through;
@@ -35,10 +36,10 @@ from gyro.results.sensitivity import Sensitivities
 from gyro.results.stability_map import StabilityMap
 from gyro.results.sweep import FrequencySweep
 from gyro.results.tolerance import ToleranceStudy
-from gyro.results.trajectory import Trajectory
+from gyro.results.trajectory import CoordinateMotion, Trajectory
 from gyro.results.verdict import Verdict
 
 __all__ = ["TMP_TAG", "save_figure", "FORMULA_BAD", "CampbellDiagram", "AngleTrajectory", "ConditionMap",
            "EquilibriumStability", "ModalResult", "Spectrum", "Stability", "classify", "nearest_error",
-           "StabilityMap", "FrequencySweep", "Trajectory", "Verdict", "Sensitivities", "ToleranceStudy",
+           "StabilityMap", "FrequencySweep", "Trajectory", "CoordinateMotion", "Verdict", "Sensitivities", "ToleranceStudy",
            "Scene", "LevelMap", "ImagePointMotion", "HarmonicResponse", "ForcedResponse"]

@@ -17,7 +17,7 @@ class EquilibriumStability:
 
     model: str
     title: str
-    params: dict  # command-line names
+    params: dict  # the declared names
     equilibrium: dict
     theta: float
     chi: float
@@ -30,6 +30,9 @@ class EquilibriumStability:
     boundary_reason: str | None = None  # one line where the verdict is 'boundary' (or 'marginal')
     margin_bounds: dict = field(default_factory=dict)  # name -> rounding bound of the margin
     radii: np.ndarray | None = None  # (2n,) error radius of each eigenvalue
+    # {another name: the declared one} (lambda for lam): the JSON's params carry both, as
+    # they carried lambda before the commands printed the declared name
+    aliases: dict = field(default_factory=dict)
 
     @property
     def boundary(self) -> bool:
@@ -38,7 +41,8 @@ class EquilibriumStability:
 
     def to_dict(self) -> dict:
         """The `gyro stability --json` document (its keys are the contract)."""
-        return {"model": self.model, "params": dict(self.params), "equilibrium": dict(self.equilibrium),
+        params = dict(self.params) | {a: self.params[n] for a, n in self.aliases.items() if n in self.params}
+        return {"model": self.model, "params": params, "equilibrium": dict(self.equilibrium),
                 "theta": float(self.theta), "chi": float(self.chi),
                 "conditions": {k: float(v) for k, v in self.conditions.items()},
                 "sufficient": bool(self.sufficient),
@@ -105,7 +109,7 @@ class ConditionMap:
     values: np.ndarray  # (y, x) int: 2, 1, 0, BOUNDARY (-1), MARGINAL (-2)
     growth: np.ndarray  # (y, x) largest real part, 1/s, of a certainly unstable point (0 elsewhere)
     orbit: bool = False
-    base: dict = field(default_factory=dict)  # the other parameters (command-line names)
+    base: dict = field(default_factory=dict)  # the other parameters (declared names)
     boundary: np.ndarray | None = None  # (y, x) bool: rounding could change the verdict
     reasons: np.ndarray | None = None  # (y, x) object: why a point is a boundary (None elsewhere)
 

@@ -208,7 +208,8 @@ def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
     if spec.steady is not None:  # a steady coordinate's own zero root is no neutral mode of the motion
         neutral &= ~spec.steady
     failed = ~np.all(np.isfinite(spec.frequencies) & np.isfinite(spec.growth), axis=1)
-    unknown = ~np.all(bounded, axis=1)
+    # a steady coordinate's own zero root is zero by construction, whatever bound a rung gives it
+    unknown = ~np.all(bounded | (spec.steady if spec.steady is not None else False), axis=1)
     if not spec.growth_known:  # the formulas assume a stable gyrocompass: no growth rates
         unknown = np.ones(len(lam), bool)
     # boundaries (gyro.results.verdict): rounding could change the verdict where two resolved
@@ -217,6 +218,7 @@ def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
     # (rounding decides whether it is a zero root, an oscillation or a growth: phi = 90 deg)
     radius = np.where(resolved & (lam > 0), np.where(resolved, est, 0.0) * lam, -np.inf)  # -inf: meets none
     merged = np.any(verdict.overlapping(spec.growth + 1j * spec.frequencies, radius), axis=2) & resolved
+    merged &= verdict.cluster_meets_axis(spec.growth + 1j * spec.frequencies, radius, est)
     unresolved = bounded & ~resolved & (lam > 0)
     if spec.steady is not None:  # a steady coordinate's own zero root is zero by construction
         unresolved &= ~spec.steady
@@ -228,16 +230,23 @@ def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
     for k in np.flatnonzero(label == "boundary"):
         if unresolved[k].any():
             j = int(np.argmax(unresolved[k]))
-            reason[k] = (f"root {j + 1} ({lam[k, j]:.3g} rad/s) is not resolved from zero (relative error "
+            reason[k] = (f"root {j + 1} ({_root(spec, k, j, 3)}) is not resolved from zero (relative error "
                          f"{est[k, j]:.2g}): rounding decides whether it is a zero root")
         else:
             i, j = np.flatnonzero(merged[k])[:2]
-            reason[k] = (f"roots {i + 1} and {j + 1} ({lam[k, i]:.9g}, {lam[k, j]:.9g} rad/s) merge within their "
-                         "error bounds: a possible collision")
+            reason[k] = (f"roots {i + 1} and {j + 1} ({_root(spec, k, i, 9)}, {_root(spec, k, j, 9)}) merge within "
+                         "their error bounds near the imaginary axis: a possible collision")
     rate = np.where(growing, spec.growth, 0.0).max(axis=1)
     slowest = np.where(growing, spec.growth, np.inf).min(axis=1)
     return Stability(label.astype(object), rate, growing.sum(axis=1), np.where(np.isfinite(slowest), slowest, 0.0),
                      reason)
+
+
+def _root(spec: Spectrum, k: int, j: int, digits: int) -> str:
+    """Root j of set k as the table shows it: omega in rad/s, and its real part (1/s) where
+    that lies beyond the root's error bound from zero."""
+    w, g, e = spec.frequencies[k, j], spec.growth[k, j], spec.error_estimate[k, j]
+    return f"{w:.{digits}g} rad/s" + (f" with Re {g:.3g} 1/s" if abs(g) > e * abs(g + 1j * w) else "")
 
 
 @dataclass

@@ -63,3 +63,66 @@ class Trajectory:
         fig.tight_layout()
         save_figure(fig, out)
         plt.close(fig)
+
+
+@dataclass
+class CoordinateMotion:
+    """A motion of any model from its reference (gyro/analyses/motion.py): every coordinate
+    and its rate at the times t, in the model's units, by one integrator."""
+
+    model: str
+    title: str
+    method: str
+    t: np.ndarray
+    coordinates: list
+    units: list
+    q: np.ndarray  # (times, coordinates), absolute values
+    qd: np.ndarray
+    params: dict
+    perturb: dict
+    equilibrium: dict
+    seconds: float = 0.0
+
+    def to_dict(self) -> dict:
+        """The `gyro simulate --json` document of the generic motion: `t`, one list per
+        coordinate under its name, `method`, and `rates` ({NAME_d: list}), `coordinates`,
+        `units`, `params`, `perturb`, `equilibrium`, `model`, `seconds`."""
+        out = {"model": self.model, "method": self.method, "params": self.params, "perturb": self.perturb,
+               "equilibrium": self.equilibrium, "coordinates": self.coordinates,
+               "units": dict(zip(self.coordinates, self.units)), "t": self.t.tolist(),
+               "rates": {f"{c}_d": self.qd[:, i].tolist() for i, c in enumerate(self.coordinates)},
+               "seconds": self.seconds}
+        for i, c in enumerate(self.coordinates):
+            out.setdefault(c, self.q[:, i].tolist())
+        return out
+
+    def table(self) -> str:
+        head = f"{'t [s]':>12}" + "".join(f"{c + (' [' + u + ']' if u else ''):>16}"
+                                          for c, u in zip(self.coordinates, self.units))
+        lines = [f"{self.title} ({self.model}), method {self.method}, from the reference"
+                 + (" with " + ", ".join(f"{k} {v:+g}" for k, v in self.perturb.items()) if self.perturb else ""),
+                 head]
+        for i in _shown_rows(len(self.t)):
+            lines.append(f"{self.t[i]:>12.6g}" + "".join(f"{x:>16.9g}" for x in self.q[i]))
+        return "\n".join(lines + _more_rows(len(self.t)))
+
+    def save(self, path) -> None:
+        _save_npz(self, path)
+
+    @classmethod
+    def load(cls, path) -> "CoordinateMotion":
+        return _load_npz(cls, path)
+
+    def plot(self, out) -> None:
+        """Each coordinate against t, written whole or not at all."""
+        plt = _pyplot()
+        n = len(self.coordinates)
+        fig, axes = plt.subplots(n, 1, sharex=True, figsize=(7, min(1.6 * n + 1, 14)), squeeze=False)
+        for ax, name, unit, y in zip(axes[:, 0], self.coordinates, self.units, self.q.T):
+            ax.plot(self.t, y, lw=1)
+            ax.set_ylabel(f"{name} [{unit}]" if unit else name, fontsize=8)
+        axes[0, 0].set_title(f"{self.title}, {self.method}", fontsize=9)
+        axes[-1, 0].set_xlabel("t [s]")
+        fig.tight_layout()
+        save_figure(fig, out)
+        plt.close(fig)

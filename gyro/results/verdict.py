@@ -8,8 +8,9 @@ The labels:
   bounds);
 - ``marginal``: a neutral direction found exactly (an exact zero root: a free coordinate);
 - ``unstable``: a root grows by more than its error bound;
-- ``boundary``: rounding could change the verdict (roots merged within their error bounds,
-  a root not resolved from zero, a condition's margin within its rounding bound of zero);
+- ``boundary``: rounding could change the verdict (roots merged within their error bounds
+  in a cluster that may reach the imaginary axis: cluster_meets_axis; a root not resolved
+  from zero; a condition's margin within its rounding bound of zero);
   never counted as stable or as stabilised;
 - ``unknown``: no bound (a method that lost a root, or computes no growth rates);
 - ``failed``: the set could not be computed.
@@ -91,6 +92,39 @@ def overlapping(lam: np.ndarray, radius: np.ndarray) -> np.ndarray:
     return (d <= radius[:, :, None] + radius[:, None, :]) & ~np.eye(lam.shape[1], dtype=bool)
 
 
+def cluster_meets_axis(lam: np.ndarray, radius: np.ndarray, rel: np.ndarray) -> np.ndarray:
+    """(sets, m): root i belongs to a cluster (roots whose disks |z - lam| <= radius overlap,
+    joined transitively) that may reach the imaginary axis, where a collision can change a
+    verdict. A single root's bound does not hold inside a cluster: a c-fold root of a
+    problem perturbed by a relative delta moves by up to |lambda| delta^(1/c) (the Puiseux
+    expansion of a c-fold root; a Jordan block attains it), so the cluster's roots are known
+    only to R = 2 max |lambda| max(rel)^(1/c), rel the members' relative error bounds (each
+    at least the backward error it rests on). A cluster all of whose roots lie farther than
+    R from the axis keeps every root on its side whatever rounding did: a double root well
+    inside the left half-plane (a damped isotropic rotor at rest: Re <= -12.7 1/s, R about
+    1e-15 1/s) cannot change the verdict. Roots in no cluster: True (their own disks
+    decide)."""
+    lam, radius, rel = np.atleast_2d(lam), np.atleast_2d(radius), np.atleast_2d(rel)
+    ov = overlapping(lam, radius)
+    out = np.ones(lam.shape, bool)
+    for k in np.flatnonzero(ov.any(axis=(1, 2))):
+        seen = np.zeros(lam.shape[1], bool)
+        for i in np.flatnonzero(ov[k].any(axis=1)):
+            if seen[i]:
+                continue
+            members, todo = {int(i)}, [int(i)]
+            while todo:
+                new = set(np.flatnonzero(ov[k, todo.pop()]).tolist()) - members
+                members |= new
+                todo += list(new)
+            c = np.array(sorted(members))
+            seen[c] = True
+            with np.errstate(all="ignore"):
+                R = 2 * np.max(np.abs(lam[k, c])) * np.max(np.abs(rel[k, c])) ** (1.0 / len(c))
+            out[k, c] = not np.all(np.abs(lam[k, c].real) > R)  # NaN: it may
+    return out
+
+
 def spectrum(lam: np.ndarray, radius: np.ndarray, conservative: bool = True,
              exact_zero: np.ndarray | None = None) -> Verdict:
     """Verdicts from eigenvalues lam (sets, m) and error radii (sets, m): the exact roots
@@ -99,7 +133,7 @@ def spectrum(lam: np.ndarray, radius: np.ndarray, conservative: bool = True,
 
     - unstable: some disk lies in Re z > 0 (a root grows whatever rounding did); when
       `conservative`, also a disk wholly in Re z < 0 (its mirror root grows);
-    - boundary: otherwise, two disks overlap, or (when `conservative`) a root's mirror disk
+    - boundary: otherwise, when `conservative`, two disks overlap or a root's mirror disk
       meets another root's disk (the exact roots may coincide there: a Krein collision, a
       Jordan block, a zero root with its mirror image);
     - stable: otherwise, when `conservative` (a Hamiltonian spectrum: an isolated disk that
@@ -137,7 +171,9 @@ def spectrum(lam: np.ndarray, radius: np.ndarray, conservative: bool = True,
         d = np.abs(-np.conj(lam)[:, :, None] - lam[:, None, :])
         overlap |= (d <= r[:, :, None] + r[:, None, :]) & ~np.eye(m, dtype=bool)
     at_zero = np.abs(lam) <= r
-    merged = np.any(overlap, axis=(1, 2))
+    # without `conservative` the disks decide alone: a union of disks in Re z < 0 holds only
+    # roots there (the disks are rigorous, merged or not), one that meets the axis is on_axis
+    merged = np.any(overlap, axis=(1, 2)) if conservative else np.zeros(n, bool)
     on_axis = np.any(np.abs(lam.real) <= r, axis=1)
     label = np.full(n, "stable", dtype=object)
     reason = np.full(n, None, dtype=object)

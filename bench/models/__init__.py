@@ -1,0 +1,1 @@
+"""Model families the benches generate (a model file per member, written by the bench)."""

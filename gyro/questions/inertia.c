@@ -1,0 +1,212 @@
+/* The number of negative eigenvalues of the Hermitian Q(w) = K - w^2 M + i w D, proven, for
+ * a batch (gyro.questions.frequencies.counts_at, docs/hierarchy.md): for each set and each
+ * of its P points w, the diagonally scaled A = S Q S (s_i = (|K_ii| + w^2 M_ii)^-1/2,
+ * Sylvester: the same inertia) is factored P^T A P = L B L^H by Bunch and Kaufman's diagonal
+ * pivoting (1 x 1 and 2 x 2 blocks, alpha = (1 + sqrt 17)/8); the inertia of A + E is that of
+ * the blocks of B. The factors are exact for an E with
+ * ||E|| <= 8 n eps (||A||_F + sum_b ||B_b|| ||L_b||_F^2) (Higham, Thm 11.4), and the matrix
+ * as formed is within 64 eps of the size of its entries, |K| + w^2 |M| + w |D|, of the
+ * operator's; L B L^H has no eigenvalue within 1 / ||L^-H B^-1 L^-1||_F of zero (the inverse
+ * formed from the factors; its rounding held to a quarter by n eps cond_F(L) < 1/4, whence the
+ * factor 2 below). Where twice the perturbations stay below that, Weyl's inequality leaves
+ * every sign as computed and the count is written; -1 otherwise, and -2 at every point of a
+ * set whose M or K is not symmetric or D not skew (bearing damping: no such count).
+ * M, D, K are (N, n, n) row-major, w (N, P), out (N, P); n <= 32. Complex numbers are pairs
+ * of doubles (C99's complex product calls a library routine for its infinities). */
+#include <math.h>
+#include "inertia.h"
+
+#define NMAX 32
+
+static double count_one(long n, const double *M, const double *D, const double *K, double w)
+{
+    double ar[NMAX][NMAX], ai[NMAX][NMAX], lr[NMAX][NMAX], li[NMAX][NMAX];
+    double s[NMAX], binv[NMAX][4];  /* per pivot column: its block's inverse row, (re, im) x 2 */
+    long bsize[NMAX];
+    const double eps = 2.220446049250313e-16;
+    double magF = 0.0, normA = 0.0;
+    for (long i = 0; i < n; i++) {
+        double d = fabs(K[i * n + i]) + w * w * M[i * n + i];
+        if (!(d > 0.0) || !isfinite(d)) return -1.0;
+        s[i] = 1.0 / sqrt(d);
+    }
+    for (long i = 0; i < n; i++)
+        for (long j = 0; j < n; j++) {
+            double sc = s[i] * s[j];
+            double re = (K[i * n + j] - w * w * M[i * n + j]) * sc, im = w * D[i * n + j] * sc;
+            double mg = (fabs(K[i * n + j]) + w * w * fabs(M[i * n + j]) + w * fabs(D[i * n + j])) * sc;
+            if (!isfinite(re) || !isfinite(im) || !isfinite(mg)) return -1.0;
+            ar[i][j] = re;
+            ai[i][j] = im;
+            lr[i][j] = (i == j) ? 1.0 : 0.0;
+            li[i][j] = 0.0;
+            magF += mg * mg;
+            normA += re * re + im * im;
+        }
+    magF = sqrt(magF);
+    normA = sqrt(normA);
+    const double alpha = (1.0 + sqrt(17.0)) / 8.0;
+    double growth = 0.0;
+    long negative = 0, k = 0;
+    while (k < n) {
+        double absakk = fabs(ar[k][k]), colmax = 0.0;
+        long r = k;
+        for (long i = k + 1; i < n; i++) {
+            double m2 = ar[i][k] * ar[i][k] + ai[i][k] * ai[i][k];
+            if (m2 > colmax) { colmax = m2; r = i; }
+        }
+        colmax = sqrt(colmax);
+        if (absakk == 0.0 && colmax == 0.0) return -1.0;
+        long size = 1, swap = k;
+        if (absakk < alpha * colmax) {
+            double rowmax = 0.0;
+            for (long j = k; j < n; j++) {
+                double m2 = ar[r][j] * ar[r][j] + ai[r][j] * ai[r][j];
+                if (j != r && m2 > rowmax) rowmax = m2;
+            }
+            rowmax = sqrt(rowmax);
+            if (absakk * rowmax >= alpha * colmax * colmax) { size = 1; swap = k; }
+            else if (fabs(ar[r][r]) >= alpha * rowmax) { size = 1; swap = r; }
+            else { size = 2; swap = r; }
+        }
+        long t = (size == 1) ? k : k + 1;
+        if (swap != t) {  /* symmetric swap of t and swap in A, and of L's finished rows */
+            long u = swap;
+            for (long j = 0; j < n; j++) {
+                double x = ar[t][j]; ar[t][j] = ar[u][j]; ar[u][j] = x;
+                x = ai[t][j]; ai[t][j] = ai[u][j]; ai[u][j] = x;
+            }
+            for (long i = 0; i < n; i++) {
+                double x = ar[i][t]; ar[i][t] = ar[i][u]; ar[i][u] = x;
+                x = ai[i][t]; ai[i][t] = ai[i][u]; ai[i][u] = x;
+            }
+            for (long j = 0; j < k; j++) {
+                double x = lr[t][j]; lr[t][j] = lr[u][j]; lr[u][j] = x;
+                x = li[t][j]; li[t][j] = li[u][j]; li[u][j] = x;
+            }
+        }
+        if (size == 1) {
+            double d = ar[k][k];
+            if (d == 0.0 || !isfinite(d)) return -1.0;
+            negative += d < 0;
+            bsize[k] = 1;
+            binv[k][0] = 1.0 / d; binv[k][1] = 0.0; binv[k][2] = 0.0; binv[k][3] = 0.0;
+            double lnorm = 1.0;
+            for (long i = k + 1; i < n; i++) {
+                lr[i][k] = ar[i][k] / d;
+                li[i][k] = ai[i][k] / d;
+                lnorm += lr[i][k] * lr[i][k] + li[i][k] * li[i][k];
+            }
+            /* A_ij -= l_i d conj(l_j) = l_i conj(a_jk) */
+            for (long i = k + 1; i < n; i++)
+                for (long j = k + 1; j < n; j++) {
+                    ar[i][j] -= lr[i][k] * ar[j][k] + li[i][k] * ai[j][k];
+                    ai[i][j] -= li[i][k] * ar[j][k] - lr[i][k] * ai[j][k];
+                }
+            growth += fabs(d) * lnorm;
+        } else {
+            double a = ar[k][k], c = ar[k + 1][k + 1];
+            double br = ar[k][k + 1], bi = ai[k][k + 1];  /* b = A[k][k+1] */
+            double b2 = br * br + bi * bi, det = a * c - b2;
+            if (det == 0.0 || !isfinite(det)) return -1.0;
+            double mid = 0.5 * (a + c), rad = sqrt(0.25 * (a - c) * (a - c) + b2);
+            double e1 = mid - rad, e2 = mid + rad;  /* the block's eigenvalues */
+            negative += (e1 < 0) + (e2 < 0);
+            double smax = fmax(fabs(e1), fabs(e2));
+            bsize[k] = bsize[k + 1] = 2;
+            /* E^-1 = [[c, -b], [-conj b, a]] / det */
+            binv[k][0] = c / det; binv[k][1] = 0.0; binv[k][2] = -br / det; binv[k][3] = -bi / det;
+            binv[k + 1][0] = -br / det; binv[k + 1][1] = bi / det; binv[k + 1][2] = a / det; binv[k + 1][3] = 0.0;
+            double lnorm = 2.0;
+            for (long i = k + 2; i < n; i++) {
+                double xr = ar[i][k], xi = ai[i][k], yr = ar[i][k + 1], yi = ai[i][k + 1];
+                /* [x, y] E^-1 = [x c - y conj b, y a - x b] / det */
+                lr[i][k] = (xr * c - (yr * br + yi * bi)) / det;
+                li[i][k] = (xi * c - (yi * br - yr * bi)) / det;
+                lr[i][k + 1] = (yr * a - (xr * br - xi * bi)) / det;
+                li[i][k + 1] = (yi * a - (xr * bi + xi * br)) / det;
+                lnorm += lr[i][k] * lr[i][k] + li[i][k] * li[i][k] + lr[i][k + 1] * lr[i][k + 1]
+                         + li[i][k + 1] * li[i][k + 1];
+            }
+            /* A_ij -= L_ik A_kj + L_i,k+1 A_k+1,j with A_kj = conj(A_jk) */
+            for (long i = k + 2; i < n; i++)
+                for (long j = k + 2; j < n; j++) {
+                    double pr = ar[j][k], pi = -ai[j][k], qr = ar[j][k + 1], qi = -ai[j][k + 1];
+                    ar[i][j] -= lr[i][k] * pr - li[i][k] * pi + lr[i][k + 1] * qr - li[i][k + 1] * qi;
+                    ai[i][j] -= lr[i][k] * pi + li[i][k] * pr + lr[i][k + 1] * qi + li[i][k + 1] * qr;
+                }
+            growth += smax * lnorm;
+        }
+        k += size;
+    }
+    /* X = L^-1 by forward substitution (L unit lower triangular), its and L's Frobenius norms */
+    double xr[NMAX][NMAX], xi[NMAX][NMAX];
+    double xF = 0.0, lF = 0.0;
+    for (long i = 0; i < n; i++)
+        for (long j = 0; j < n; j++) {
+            xr[i][j] = (i == j) ? 1.0 : 0.0;
+            xi[i][j] = 0.0;
+            lF += lr[i][j] * lr[i][j] + li[i][j] * li[i][j];
+        }
+    for (long j = 0; j < n; j++)
+        for (long i = j + 1; i < n; i++) {
+            double pr = lr[i][j], pi = li[i][j];
+            if (pr == 0.0 && pi == 0.0) continue;
+            for (long m = 0; m <= j; m++) {
+                xr[i][m] -= pr * xr[j][m] - pi * xi[j][m];
+                xi[i][m] -= pr * xi[j][m] + pi * xr[j][m];
+            }
+        }
+    for (long i = 0; i < n; i++)
+        for (long j = 0; j <= i; j++) xF += xr[i][j] * xr[i][j] + xi[i][j] * xi[i][j];
+    if (!(n * eps * sqrt(lF * xF) < 0.25)) return -1.0;
+    /* Z = B^-1 X, then ||X^H Z||_F: the inverse of L B L^H */
+    double zr[NMAX][NMAX], zi[NMAX][NMAX];
+    for (long i = 0; i < n;) {
+        long o = (bsize[i] == 2) ? i + 1 : i;
+        for (long row = i; row <= o; row++)
+            for (long m = 0; m < n; m++) {
+                double r0 = binv[row][0], i0 = binv[row][1], r1 = binv[row][2], i1 = binv[row][3];
+                double ur = xr[i][m], ui = xi[i][m];
+                double vr = (o > i) ? xr[o][m] : 0.0, vi = (o > i) ? xi[o][m] : 0.0;
+                zr[row][m] = r0 * ur - i0 * ui + r1 * vr - i1 * vi;
+                zi[row][m] = r0 * ui + i0 * ur + r1 * vi + i1 * vr;
+            }
+        i = o + 1;
+    }
+    double yF = 0.0;
+    for (long i = 0; i < n; i++)
+        for (long m = 0; m < n; m++) {
+            double yr = 0.0, yi = 0.0;
+            for (long j = 0; j < n; j++) {  /* conj(X_ji) Z_jm */
+                yr += xr[j][i] * zr[j][m] + xi[j][i] * zi[j][m];
+                yi += xr[j][i] * zi[j][m] - xi[j][i] * zr[j][m];
+            }
+            yF += yr * yr + yi * yi;
+        }
+    double lower = 1.0 / sqrt(yF);
+    double pert = 8.0 * n * eps * (normA + growth) + 64.0 * eps * magF;
+    if (!(2.0 * pert < lower)) return -1.0;
+    return (double)negative;
+}
+
+/* M and K symmetric and D skew to the bit: the structure the count rests on */
+static int gyroscopic(long n, const double *M, const double *D, const double *K)
+{
+    for (long i = 0; i < n; i++)
+        for (long j = 0; j <= i; j++)
+            if (M[i * n + j] != M[j * n + i] || K[i * n + j] != K[j * n + i] || D[i * n + j] != -D[j * n + i])
+                return 0;
+    return 1;
+}
+
+void gyro_inertia_counts(long N, long n, long P, const double *M, const double *D, const double *K,
+                         const double *w, double *out)
+{
+    for (long b = 0; b < N; b++) {
+        const double *Mb = M + b * n * n, *Db = D + b * n * n, *Kb = K + b * n * n;
+        int structured = gyroscopic(n, Mb, Db, Kb);
+        for (long p = 0; p < P; p++)
+            out[b * P + p] = !structured ? -2.0 : (n > NMAX) ? -1.0 : count_one(n, Mb, Db, Kb, w[b * P + p]);
+    }
+}

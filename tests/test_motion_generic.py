@@ -1,0 +1,87 @@
+"""`gyro simulate MODEL` for any model (gyro/analyses/motion.py): the emitted nonlinear
+equations from the reference of the set (derive/outputs/reference.py), offsets by name, on
+model files written outside the package.
+
+Tolerances: DOP853 at rtol 1e-10, atol 1e-12 over a few periods of a smooth motion errs by
+about 1e-10 of its amplitude; the damped oscillator's closed form is held to 1e-8 of the
+offset, two orders above."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from tests.conftest import ROOT, run_cli, error_lines
+
+MODELS = ROOT / "tests" / "models"
+ROTOR = ROOT / "examples" / "rigid_rotor.py"
+
+
+def test_the_damped_oscillator_moves_as_its_closed_form():
+    rc, out, err = run_cli("simulate", str(MODELS / "damped_oscillator.py"), "--t-end", "3", "--points", "61",
+                           "--perturb", "x=0.1", "--perturb", "x_d=-0.2", "--json")
+    assert rc == 0, err
+    doc = json.loads(out)
+    m, c, k = 2.0, 0.3, 50.0
+    t = np.array(doc["t"])
+    s, w = -c / (2 * m), np.sqrt(k / m - c**2 / (4 * m**2))
+    x0, v0 = 0.1, -0.2
+    want = np.exp(s * t) * (x0 * np.cos(w * t) + (v0 - s * x0) / w * np.sin(w * t))
+    assert np.max(np.abs(np.array(doc["x"]) - want)) < 1e-8 * x0
+    assert doc["method"] == "DOP853" and doc["coordinates"] == ["x"] and doc["units"] == {"x": "m"}
+    assert doc["perturb"] == {"x": 0.1, "x_d": -0.2} and len(doc["rates"]["x_d"]) == 61
+
+
+def test_at_the_reference_the_rotor_stays_there():
+    """No offset: the rigid rotor on its bearings (examples/rigid_rotor.py) stays at its
+    equilibrium, every coordinate within 1e-12 of its reference over 50 ms, but the spin
+    angle phi, which turns steadily at Omega (its declared rate)."""
+    rc, out, err = run_cli("simulate", str(ROTOR), "--t-end", "0.05", "--points", "11", "--set", "Omega=300",
+                           "--json")
+    assert rc == 0, err
+    doc = json.loads(out)
+    t = np.array(doc["t"])
+    assert doc["rates"]["phi_d"][0] == 300.0
+    for c in doc["coordinates"]:
+        want = 300.0 * t if c == "phi" else doc[c][0]
+        assert np.max(np.abs(np.array(doc[c]) - want)) < 1e-12 * max(1.0, np.max(np.abs(want))), c
+
+
+def test_a_time_dependent_model_takes_its_time():
+    """The Mathieu pendulum (explicit t in its equations) against its textbook equation
+    integrated here, m l^2 theta'' + c theta' + m l (g - a w^2 sin(w t)) sin(theta) = 0
+    (tests/models/mathieu_pendulum.py, its default parameters)."""
+    from scipy.integrate import solve_ivp
+
+    rc, out, err = run_cli("simulate", str(MODELS / "mathieu_pendulum.py"), "--t-end", "2", "--points", "21",
+                           "--perturb", "theta=0.3", "--json")
+    assert rc == 0, err
+    doc = json.loads(out)
+    m, l, g, a, w, c = 0.5, 0.8, 9.81, 0.05, 7.0, 0.01
+
+    def textbook(t, y):
+        return [y[1], -(c * y[1] + m * l * (g - a * w**2 * np.sin(w * t)) * np.sin(y[0])) / (m * l**2)]
+
+    sol = solve_ivp(textbook, (0, 2), [0.3, 0.0], method="DOP853", t_eval=np.array(doc["t"]), rtol=1e-11, atol=1e-13)
+    assert np.max(np.abs(sol.y[0] - np.array(doc["theta"]))) < 1e-8
+
+
+@pytest.mark.parametrize("args, match", [
+    (["--perturb", "nope=1"], "--perturb nope: not a coordinate of damped_oscillator"),
+    (["--perturb", "x=1", "--perturb", "x=2"], "--perturb x: given twice"),
+    (["--perturb", "x"], "--perturb 'x': expected NAME=VALUE"),
+    (["--perturb", "x=inf"], "--perturb x"),
+    (["--method", "Euler"], "--method: unknown method 'Euler'"),
+    (["--level", "full"], "--level: only for gimbal_precession"),
+    # 5 rad/s for 1e9 s: about 4e11 evaluations, refused before the start, naming the cost
+    (["--t-end", "1e9"], "would need about 3.8e+11 evaluations of the equations, over its budget of 5e+06"),
+])
+def test_bad_input_is_one_line_exit_2(args, match):
+    rc, out, err = run_cli("simulate", str(MODELS / "damped_oscillator.py"), "--t-end", "1", *args)
+    assert rc == 2 and out == "" and match in err and len(error_lines(err)) == 1, err
+
+
+def test_a_reference_of_given_momenta_is_refused_in_one_line():
+    rc, out, err = run_cli("simulate", str(MODELS / "symmetric_top_euler.py"), "--t-end", "1")
+    assert rc == 2 and out == "" and "stationary motion of given momenta (Lz, H)" in err

@@ -59,10 +59,15 @@ def model_source(text: str) -> str | None:
     if "/" not in text and "\\" not in text and not text.endswith(".py") and text in available():
         return "builtin"
     path = Path(text).expanduser()
-    if path.is_dir():
-        if (path / "metadata.json").is_file():
-            return "emitted"
-        return "file" if (path / "__init__.py").is_file() else None
-    if path.is_file() and path.suffix == ".py":
-        return "file"
+    try:
+        if path.is_dir():
+            if (path / "metadata.json").is_file():
+                return "emitted"
+            return "file" if (path / "__init__.py").is_file() else None
+        if path.is_file() and path.suffix == ".py":
+            return "file"
+    except OSError as exc:  # a name longer than the file system takes (ENAMETOOLONG), a loop of links
+        shown = text if len(text) <= 60 else text[:40] + "..." + text[-12:]
+        raise ParameterError(f"model {shown!r}: {exc.strerror or exc} ({len(text.encode(errors='surrogateescape'))} "
+                             "bytes)") from None
     return None

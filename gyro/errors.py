@@ -40,3 +40,35 @@ def grid_axis(flag: str, text: str, names, most: int, what: str = "axis") -> tup
     if not 2 <= n <= most:
         raise ParameterError(f"{flag} {name}: N must lie in [2, {most}], got {n}")
     return name, lo, hi, n
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the code is (inside `terminable()`), so that its `finally`
+    blocks run: the command line stops as on Ctrl-C, says so and exits 143."""
+
+
+class terminable:
+    """`with terminable():` SIGTERM raises Terminated in the main thread while the block
+    runs, the handler before is restored after. Only around work that leaves something to
+    clean up (a temporary folder) and that returns to Python often (chunks): a handler
+    runs between bytecodes, so around one long compiled call it would hold the signal off
+    until the call returns, where the default ends the process at once."""
+
+    def __enter__(self):
+        import signal
+        import threading
+
+        self.saved = None
+        if threading.current_thread() is threading.main_thread():
+            def stop(signum, frame):
+                raise Terminated()
+
+            self.saved = signal.signal(signal.SIGTERM, stop)
+        return self
+
+    def __exit__(self, *exc):
+        import signal
+
+        if self.saved is not None:
+            signal.signal(signal.SIGTERM, self.saved)
+        return False

@@ -20,11 +20,45 @@ from __future__ import annotations
 
 import os
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
 
 SERIAL = None  # the in-process executor
+BUDGET: float | None = None  # seconds a run in this process may take (the command line sets it: budget())
+
+
+class budget:
+    """`with budget(seconds):` runs in this process are held to `seconds`: the time of the
+    chunks done so far, carried to all of them, is checked after each chunk, and a run that
+    would go over stops there (after the first chunk where the request is large: one line
+    naming the cost, ParameterError). A run on Dask is not held to it (the cluster is the
+    user's)."""
+
+    def __init__(self, seconds: float | None):
+        self.seconds = seconds
+
+    def __enter__(self):
+        global BUDGET
+        self.saved, BUDGET = BUDGET, self.seconds
+        return self
+
+    def __exit__(self, *exc):
+        global BUDGET
+        BUDGET = self.saved
+        return False
+
+
+def over_budget(n: int, done: int, seconds: float, limit: float) -> None:
+    """ParameterError when n sets at the pace of `done` in `seconds` would take over `limit`."""
+    from gyro.errors import ParameterError
+
+    each = seconds / max(done, 1)
+    if n * each > limit:
+        raise ParameterError(f"{n} parameter sets would take about {n * each:.0f} s in this process "
+                             f"({each * 1e3:.2g} ms a set, measured on {done}), over the command line's budget "
+                             f"of {limit:.0f} s: ask for fewer, or run them on --scheduler local or a cluster")
 
 
 def bounds(n: int, chunk: int) -> list[tuple[int, int]]:
@@ -71,8 +105,12 @@ def client(scheduler):
     if isinstance(scheduler, Client):
         return scheduler
     if scheduler == "local":
+        import logging
+
+        # the workers' own log lines (ports, memory, a worker restarted) are not the command's
+        # output: its one line says what failed (silence_logs is the level shown, WARN by default)
         cluster = LocalCluster(n_workers=max(1, os.cpu_count() or 1), threads_per_worker=1, processes=True,
-                               dashboard_address=None)
+                               dashboard_address=None, silence_logs=logging.CRITICAL)
         return Client(cluster)
     try:
         return Client(scheduler, timeout="10s")
@@ -112,10 +150,16 @@ def run(fn, n: int, chunk: int, args: tuple = (), scheduler=SERIAL, folder: Path
         bar = tqdm(total=n, desc=desc, unit="set", leave=False, file=sys.stderr)
     try:
         if scheduler is SERIAL:
+            limit = BUDGET
+            if limit is not None and warm is not None:
+                warm(*warm_args)  # a first compile or load is not the pace of the run
+            t0 = time.perf_counter()
             for s, e in spans:
                 sink.put(s, fn(s, e, *args))
                 if bar is not None:
                     bar.update(e - s)
+                if limit is not None and e < n:
+                    over_budget(n, e, time.perf_counter() - t0, limit)
         else:
             _run_dask(fn, spans, args, scheduler, sink, bar, warm, warm_args, inflight)
     finally:

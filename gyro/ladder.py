@@ -135,6 +135,19 @@ def with_modes(model: Model, params, spec: Spectrum) -> Spectrum:
     return replace(spec, modes=qep.eigenvectors(M, D, K, spec.growth + 1j * spec.frequencies))
 
 
+def require_finite(model: Model, spec, where: str = "these parameters") -> None:
+    """One line (a numerical failure, FloatingPointError), no table, where set 0 of `spec`
+    has no finite spectrum, saying why: no equilibrium found (a model such as
+    gimbal_precession, whose gyroscope precesses instead of resting), or a root without a
+    finite value."""
+    if np.all(np.isfinite(spec.frequencies[0])) and np.all(np.isfinite(spec.growth[0])):
+        return
+    if spec.equilibrium is not None and not np.all(np.isfinite(spec.equilibrium[0])):
+        raise FloatingPointError(f"{model.name}: no equilibrium found at {where}, so no natural frequencies "
+                                 "about one")
+    raise FloatingPointError(f"a frequency is not finite at {where}")
+
+
 def natural_frequencies(model: Model, values: dict, method: str = "default") -> ModalResult:
     """The natural frequencies of the exact operator about the exact equilibrium, for one
     parameter set, by a method of the ladder (the default one unless told)."""

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import json
 import math
 from dataclasses import dataclass
 from functools import cached_property
@@ -57,13 +58,20 @@ class Model:
                 raise ParameterError(f"{self.directory}: no generated model there (no metadata.json)")
             package = _import_directory(self.directory)
         pkg = importlib.import_module(package)
+        if not isinstance(pkg.METADATA, dict) or "parameters" not in pkg.METADATA or "model" not in pkg.METADATA:
+            raise ParameterError(f"{self.directory / 'metadata.json'}: not a generated model's metadata "
+                                 "(no model or parameters)")
         if pkg.METADATA["model"] != name:
             raise ParameterError(f"{self.directory} holds the model {pkg.METADATA['model']!r}, not {name!r}")
         self.package = package
         self.name = name
         self.meta = pkg.METADATA
-        self.params = [Param(p["name"], p["unit"], p["default"], p["description"], p["kind"],
-                             tuple(p["bounds"])) for p in self.meta["parameters"]]
+        try:
+            self.params = [Param(p["name"], p["unit"], p["default"], p["description"], p["kind"],
+                                 tuple(p["bounds"])) for p in self.meta["parameters"]]
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ParameterError(f"{self.directory / 'metadata.json'}: not a generated model's metadata "
+                                 f"(its parameters: {_reason(exc)})") from None
         self.param_names = [p.name for p in self.params]
 
     @cached_property
@@ -155,12 +163,36 @@ def _import_directory(directory: Path) -> str:
 
     name = "_gyro_model_" + hashlib.sha256(str(directory).encode()).hexdigest()[:12]
     if name not in sys.modules:
+        meta = directory / "metadata.json"
+        try:
+            json.loads(meta.read_text())
+        except (OSError, ValueError) as exc:  # the file named, not the package's __init__ that reads it
+            raise ParameterError(f"{meta}: not a generated model's metadata ({_reason(exc)})") from None
         spec = importlib.util.spec_from_file_location(name, directory / "__init__.py",
                                                       submodule_search_locations=[str(directory)])
+        if spec is None:
+            raise ParameterError(f"{directory}: no generated model there (no __init__.py)")
         module = importlib.util.module_from_spec(spec)
         sys.modules[name] = module
-        spec.loader.exec_module(module)
+        saved = sys.dont_write_bytecode
+        sys.dont_write_bytecode = True  # nothing written beside the user's files
+        try:
+            spec.loader.exec_module(module)
+            if not isinstance(getattr(module, "METADATA", None), dict):
+                raise ParameterError(f"{directory / '__init__.py'}: not a generated model's package (no METADATA)")
+        except BaseException as exc:
+            del sys.modules[name]  # a half-imported package is not kept: the next load fails alike
+            if isinstance(exc, ParameterError) or not isinstance(exc, Exception):
+                raise
+            raise ParameterError(f"{directory}: not a generated model ({_reason(exc)})") from None
+        finally:
+            sys.dont_write_bytecode = saved
     return name
+
+
+def _reason(exc: BaseException) -> str:
+    text = str(exc).splitlines()[0] if str(exc) else ""
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
 _CACHE: dict[str, Model] = {}
@@ -260,23 +292,87 @@ def derived_folder(path: Path) -> Path:
     found = [d for d in done.iterdir() if (d / "metadata.json").is_file()] if done.is_dir() else []
     if len(found) == 1:
         return found[0]
+    failed = home / f"{done.name}.failed"  # a file the machinery refused: the same inputs, the same line
+    if failed.is_file():
+        raise ParameterError(failed.read_text().strip())
     home.mkdir(parents=True, exist_ok=True)
     tmp = home / f"{done.name}.tmp-{os.getpid()}"
     shutil.rmtree(tmp, ignore_errors=True)
-    print(f"gyro: deriving the model file {path} (first use; cached in {done}) ...", file=sys.stderr, flush=True)
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(root)] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
-    proc = subprocess.run([sys.executable, "-m", "derive", "--model", str(path.resolve()), "--out", str(tmp)],
-                          cwd=root, env=env, capture_output=True, text=True)
+    notice = _Notice(f"gyro: deriving {_stem(path)} from {path} (first use, {_why(path, root)}cached after in {done})")
+    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1",  # no __pycache__ beside the user's file
+               PYTHONPATH=os.pathsep.join([str(root)] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
+    try:
+        proc = subprocess.run([sys.executable, "-m", "derive", "--model", str(path.resolve()), "--out", str(tmp)],
+                              cwd=root, env=env, capture_output=True, text=True)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        notice.end(failed=True)
+        raise
     if proc.returncode != 0:
         shutil.rmtree(tmp, ignore_errors=True)
+        notice.end(failed=True)
         lines = [ln for ln in proc.stderr.strip().splitlines() if ln.strip()]
         last = lines[-1] if lines else f"exit status {proc.returncode}"
         if proc.returncode == 2:
-            raise ParameterError(last.removeprefix("derive: "))
+            message = last.removeprefix("derive: ")
+            try:
+                if "ModuleNotFoundError" in message or "ImportError" in message:
+                    raise OSError("not cached: installing what it imports may mend it")  # written whole or not at all: a concurrent run reads the line or nothing
+                part = home / f"{failed.name}.tmp-{os.getpid()}"
+                part.write_text(message + "\n")
+                os.replace(part, failed)
+            except OSError:
+                pass
+            raise ParameterError(message)
         raise RuntimeError(f"deriving {path} failed: {last}")
+    notice.end(failed=False)
     made = [d for d in tmp.iterdir() if (d / "metadata.json").is_file()]
     try:
         os.replace(tmp, done)  # atomic: a concurrent run that finished first keeps its copy
     except OSError:
         shutil.rmtree(tmp, ignore_errors=True)
     return done / made[0].name
+
+
+def _stem(path: Path) -> str:
+    return path.resolve().parent.name if path.is_dir() or path.name == "__init__.py" else path.stem
+
+
+def _why(path: Path, root: Path) -> str:
+    """What a first derivation of `path` is, when it is a generated model's own source file."""
+    own = root / "derive" / "models" / f"{_stem(path)}.py"
+    if path.resolve() == own.resolve() and _stem(path) in available():
+        return (f"about a minute: the generated model {_stem(path)!r} is this file already derived, "
+                "give its name to skip this; ")
+    return ""
+
+
+class _Notice:
+    """The one line said while a model file is derived: on a terminal at once, erased when
+    the derivation fails (the error is then the one line left); elsewhere only once the
+    derivation has taken NOTICE_AFTER seconds (a file that is no model fails within about
+    one: its line is then the only one), a one-off notice before the command's own output.
+    A failure is cached, so the next call says its one line only."""
+
+    NOTICE_AFTER = 2.0  # s
+
+    def __init__(self, text: str):
+        import sys
+        import threading
+
+        self.tty, self.timer = sys.stderr.isatty(), None
+        if self.tty:
+            print(text + " ...", end="", file=sys.stderr, flush=True)
+        else:
+            stream = sys.stderr  # the stream of the caller's moment (a session may swap it after)
+            self.timer = threading.Timer(self.NOTICE_AFTER, lambda: print(text, file=stream, flush=True))
+            self.timer.daemon = True
+            self.timer.start()
+
+    def end(self, failed: bool) -> None:
+        import sys
+
+        if self.timer is not None:
+            self.timer.cancel()
+        elif self.tty:
+            print("\r\033[K" if failed else "", file=sys.stderr, end="" if failed else "\n", flush=True)

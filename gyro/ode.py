@@ -29,6 +29,39 @@ class Symbolic:
     ydot: object
 
 
+# CasADi integrator options that keep SUNDIALS' own lines and CasADi's warnings on a NaN
+# of the right-hand side (a horizon near 1e308) off stderr: the error raised says it
+CASADI_QUIET = {"disable_internal_warnings": True, "show_eval_warnings": False}
+
+
+class stderr_silenced:
+    """Nothing on stderr while a compiled library runs (SUNDIALS' IDAS prints its error lines
+    whatever the options, through CasADi's Python streams or file descriptor 2): both go to
+    /dev/null; the exception it raises says what failed, in the command's one line."""
+
+    def __enter__(self):
+        import os
+        import sys
+
+        sys.stderr.flush()
+        self.stream, self.saved = sys.stderr, os.dup(2)
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, 2)
+        os.close(null)
+        sys.stderr = open(os.devnull, "w")
+        return self
+
+    def __exit__(self, *exc):
+        import os
+        import sys
+
+        sys.stderr.close()
+        sys.stderr = self.stream
+        os.dup2(self.saved, 2)
+        os.close(self.saved)
+        return False
+
+
 def _key(model: Model, what: str):
     return (what, model.name, str(getattr(model, "directory", "")), id(model))
 

@@ -327,3 +327,270 @@ def test_fuzz_of_the_newer_commands(tmp_path, short_budgets):
         _contract(argv, code, out, err, dt)
         codes.append(code)
     assert len(codes) == N_NEWER and {0, 2} <= set(codes)  # answers and refusals both met
+
+
+# ------------------------------------------------------------------ every command, and model paths
+# The classes of issue 41 (docs/fuzz.md): each command line below once fell short in one of
+# them (a traceback, a runaway, a wrong exit, a contradiction accepted, a non-number printed,
+# something left behind, noise on stderr). Run in this process, under a temporary folder of
+# their own (TMPDIR), which must be empty after every command.
+
+LONG_NAME = "m" * 300 + ".py"  # over NAME_MAX (255 bytes)
+SECONDS = 30  # a command's wall time at the most (each below runs in about 1 s or less)
+
+
+def issue_lines(tmp):
+    """The command lines of the issue's classes, one or more each, for every command."""
+    deep = "/" + "/".join(["d" * 200] * 25) + ".py"  # over PATH_MAX (4096 bytes)
+    tg = ["torsion_gyrocompass"]
+    sweep = ["sweep", *tg, "--x", "H", "--x-range", "0.1", "1", "--points", "3"]
+    tol = ["tolerance", *tg, "--spread", "Kp=normal:0.05", "--spread", "K0=normal:0.05", "--quiet"]
+    unb = ["unbalance", *tg, "--force-x", "F1", "--force-y", "F2", "--magnitude", "1e-4", "--spin-range", "0.5",
+           "2", "--points", "3", "--quiet"]
+    png = str(tmp / "out.png")
+    yield from ([cmd, path] + rest for path in (LONG_NAME, deep) for cmd, rest in (
+        ("frequencies", []), ("params", []), ("stability", []), ("campbell", ["--json"]),
+        ("scene", ["frequencies", "--tol", "1e-3"]), ("level-map", ["--level", "a", "--against", "b", "--x", "u=0:1:2",
+                                                                    "--y", "H=1:2:2", "--out", png]),
+        ("unbalance", unb[2:]), ("tolerance", tol[2:] + ["--samples", "10"]), ("sweep", sweep[2:]),
+        ("stability-map", ["--x", "H", "--x-range", "0.1", "1", "--y", "u", "--y-range", "0", "1e-4", "--out", png])))
+    for out in ("", str(tmp / LONG_NAME.replace(".py", ".png")), "/proc/gyro-fuzz.png", str(tmp / "no" / "x.png")):
+        yield ["campbell", *tg, "--points", "2", "--quiet", "--out", out]
+        yield sweep + ["--out", out]
+        yield ["forced", *tg, "--harmonic", "1:1:1", "--out", out]
+        yield tol + ["--samples", "10", "--out", out]
+        yield tol + ["--samples", "10", "--tornado", out]
+        yield unb + ["--out", out]
+        yield ["simulate", "gimbal_gyroscope", "--t-end", "0.1", "--points", "3", "--out", out]
+        yield ["map", "gyrohorizoncompass", "--x", "zeta=0.05:0.8:2", "--y", "eta=-0.5:0.5:2", "--out", out]
+    yield ["forced", *tg, "--harmonic", "1:1:1", "--set", "Kp=1e300"]
+    yield unb[:7] + ["1e300", "--spin-range", "0", "1e300", "--points", "3", "--quiet"]
+    yield ["sweep", "gimbal_precession", "--x", "k_xi1", "--x-range", "0", "1e-4", "--points", "3"]
+    yield ["tolerance", "gimbal_precession", "--spread", "l_x=normal:0.05", "--samples", "10", "--quiet"]
+    yield tol + ["--samples", "10", "--correlate", "Kp,K0=0.5", "--correlate", "K0,Kp=-0.5"]
+    yield tol + ["--samples", "10", "--correlate", "Kp,K0=0.5", "--correlate", "Kp,K0=0.5"]
+    yield tol + ["--samples", "1"]
+    yield tol + ["--samples", "10", "--store", "/proc/gyro-fuzz/store"]
+    yield tol + ["--samples", "10000000"]
+    yield tol + ["--samples", "1000000000"]
+    yield ["frequencies", *tg, "--set", "A=1e-300"]
+    yield ["frequencies", *tg, "--set", "u=5e-324"]
+    yield ["frequencies", "gimbal_precession"]
+    yield ["scene", "gimbal_gyroscope", "motion", "--tol", "1e-30"]
+    yield ["scene", "gimbal_gyroscope", "motion", "--tol", "1e-3", "--horizon", "1e6"]
+    yield ["scene", "gyrohorizoncompass", "motion", "--tol", "1e-3", "--horizon", "1e6"]
+    yield ["map", "gyrohorizoncompass", "--x", "nu=1e-4:1e-3:1000", "--y", "eta=0:0.1:1000", "--out", png]
+    yield ["level-map", "gimbal_precession", "--level", "small", "--against", "full", "--x", "k_xi1=0:1e-4:100",
+           "--y", "l_x=5e-4:1e-3:100", "--out", png]
+    for method in ("cvodes", "idas"):
+        yield ["simulate", "gimbal_gyroscope", "--method", method, "--t-end", "1e308", "--points", "5"]
+
+
+def every_command_lines(tmp, n):
+    """n seeded lines over every command, valid-looking values mixed with the weird ones and
+    with the model paths that are no model (too long, missing, a folder, a junk folder)."""
+    rng = random.Random(SEED + 3)
+    tg = load("torsion_gyrocompass")
+    junk = tmp / "junk_model"
+    models = ["torsion_gyrocompass"] * 6 + [LONG_NAME, str(tmp / "none.py"), str(tmp), str(junk)]
+
+    def model():
+        return rng.choice(models)
+
+    def w(choices):
+        return rng.choice(choices) if rng.random() < 0.8 else rng.choice(WEIRD)
+
+    def out(stem):
+        return rng.choice([[], ["--out", str(tmp / f"{stem}.png")], ["--out", ""], ["--out", "/proc/x.png"]])
+
+    for i in range(n):
+        cmd = rng.choice(["scene", "stability", "map", "sweep", "level-map", "tolerance", "forced", "unbalance",
+                          "simulate", "campbell", "frequencies", "stability-map", "params"])
+        if cmd == "scene":
+            argv = [cmd, model(), rng.choice(["frequencies", "stability", "motion"]), "--tol", w(["1e-3", "1e-30", "0.1"])]
+        elif cmd == "stability":
+            argv = [cmd, rng.choice(["gyrohorizoncompass", "torsion_gyrocompass", LONG_NAME])]
+        elif cmd == "map":
+            argv = [cmd, "gyrohorizoncompass", "--x", f"nu={w(['1e-4:1e-3'])}:{w(['2', '3', '1000'])}",
+                    "--y", f"eta={w(['0:0.1'])}:{w(['2', '1000'])}"] + (out(f"g{i}") or ["--out", ""])
+        elif cmd == "sweep":
+            argv = [cmd, model(), "--x", "H", "--x-range", w(["0.1"]), w(["1"]), "--points", w(["2", "3"])] + out(f"s{i}")
+        elif cmd == "level-map":
+            argv = [cmd, model(), "--level", "formulas", "--against", "linear_exact", "--x", f"u={w(['5e-5:1e-4'])}:2",
+                    "--y", f"H={w(['1:3'])}:2"] + (out(f"l{i}") or ["--out", ""])
+        elif cmd == "tolerance":
+            argv = [cmd, model(), "--spread", f"Kp=normal:{w(['0.05'])}", "--samples", w(["10", "1", "10000000"]),
+                    "--quiet"] + rng.choice([[], ["--correlate", "Kp,Kp=0.5"]]) + out(f"t{i}")
+        elif cmd == "forced":
+            argv = [cmd, "torsion_gyrocompass", "--harmonic", f"1:1:{w(['1'])}"] + _sets(rng, tg, k=1) + out(f"f{i}")
+        elif cmd == "unbalance":
+            argv = [cmd, model(), "--force-x", "F1", "--force-y", "F2", "--magnitude", w(["1e-4"]), "--spin-range",
+                    "0.5", "2", "--points", w(["3"]), "--quiet"] + out(f"u{i}")
+        elif cmd == "simulate":
+            argv = [cmd, rng.choice(["gimbal_gyroscope", LONG_NAME]), "--t-end", w(["0.1", "1e308"]), "--points", "3",
+                    "--method", rng.choice(["closed_form", "DOP853", "cvodes"])]
+            if argv[4] == "1e308" and argv[-1] == "DOP853":
+                argv[4] = "0.1"  # a SciPy integrator to 1e308 runs to its 25 s budget: too long for a fuzz
+        elif cmd == "campbell":
+            argv = [cmd, model(), "--points", w(["2", "3"]), "--quiet"] + (out(f"c{i}") or ["--json"])
+        elif cmd == "frequencies":
+            argv = [cmd, model()] + _sets(rng, tg)
+        elif cmd == "stability-map":
+            argv = [cmd, model(), "--x", "H", "--x-range", "0.1", "1", "--y", "u", "--y-range", "0", w(["1e-4"]),
+                    "--points", w(["2", "3"]), "--quiet"] + (out(f"m{i}") or ["--out", ""])
+        else:
+            argv = [cmd, model()]
+        yield argv
+
+
+NUMBER_WORDS = __import__("re").compile(r"(?<![A-Za-z_])-?(nan|inf)(?![A-Za-z_])", __import__("re").I)
+
+
+def _holds(argv, code, out, err, dt, tmp, scratch):
+    """The contract of every command line, as docs/fuzz.md states it."""
+    where = " ".join(a if len(a) < 80 else a[:30] + "..." for a in argv)
+    assert dt < SECONDS, f"{where}: {dt:.1f} s"
+    assert "Traceback" not in err + out, f"{where}: {err}"
+    assert code in (0, 1, 2), f"{where}: exit {code}"
+    if code:
+        assert len(err.strip().splitlines()) == 1 and err.startswith(("gyro", "usage")), f"{where}: {err!r}"
+        assert "np.float64" not in err and "__init__.py" not in err, f"{where}: {err!r}"
+        assert not err.startswith(("gyro: error: omega:", "gyro: error: u:")), f"{where}: an internal name: {err!r}"
+    if code == 2:
+        assert out == "", f"{where}: stdout on bad input: {out[:200]!r}"
+    if code == 0 and "--json" not in argv:
+        assert not NUMBER_WORDS.search(out), f"{where}: a non-number printed as a number:\n{out}"
+    assert not any(scratch.iterdir()), f"{where}: left in the temporary folder: {sorted(scratch.iterdir())}"
+    left = [p.name for p in tmp.iterdir() if p.name.startswith(".")]
+    assert not left, f"{where}: left beside the outputs: {left}"
+
+
+@pytest.fixture
+def scratch(tmp_path, monkeypatch):
+    """TMPDIR for the commands: a folder of the test's own, checked empty after each."""
+    import tempfile
+
+    folder = tmp_path / "tmpdir"
+    folder.mkdir()
+    monkeypatch.setenv("TMPDIR", str(folder))
+    monkeypatch.setattr(tempfile, "tempdir", str(folder))
+    return folder
+
+
+def _junk_model(tmp):
+    """A folder that looks emitted (an __init__.py beside a metadata.json) but is junk."""
+    junk = tmp / "junk_model"
+    junk.mkdir(exist_ok=True)
+    (junk / "__init__.py").write_text("import json\nfrom pathlib import Path\n"
+                                      "METADATA = json.loads((Path(__file__).parent / 'metadata.json').read_text())\n")
+    (junk / "metadata.json").write_text("{junk")
+    return junk
+
+
+def test_the_issue_classes_on_every_command(tmp_path, scratch, short_budgets):
+    outs = tmp_path / "outs"
+    outs.mkdir()
+    codes = {}
+    for argv in issue_lines(outs):
+        code, out, err, dt = run(argv)
+        _holds(argv, code, out, err, dt, outs, scratch)
+        codes[" ".join(argv)[:120]] = code
+    assert set(codes.values()) <= {0, 1, 2} and 2 in codes.values()
+    # the exits the issue names, exactly
+    assert all(c == 2 for k, c in codes.items() if LONG_NAME[:100] in k or "--out  " in k or k.endswith("--out"))
+    assert codes["forced torsion_gyrocompass --harmonic 1:1:1 --set Kp=1e300"] == 1
+
+
+def test_the_issue_errors_name_what_the_user_gave(scratch):
+    """Each refusal names the argument the user typed, never an internal one."""
+    says = {("forced", "torsion_gyrocompass", "--harmonic", "1:1:1", "--set", "Kp=1e300"): "Kp=1e300",
+            ("tolerance", "torsion_gyrocompass", "--spread", "Kp=normal:0.05", "--spread", "K0=normal:0.05",
+             "--samples", "10", "--correlate", "Kp,K0=0.5", "--correlate", "K0,Kp=-0.5"): "--correlate",
+            ("tolerance", "torsion_gyrocompass", "--spread", "Kp=normal:0.05", "--samples", "1"): "--samples",
+            ("tolerance", "torsion_gyrocompass", "--spread", "Kp=normal:0.05", "--samples", "10000000"): "--samples",
+            ("campbell", "torsion_gyrocompass", "--out", ""): "--out",
+            ("sweep", "torsion_gyrocompass", "--x", "H", "--x-range", "0.1", "1", "--out", "/proc/x.png"): "--out",
+            ("frequencies", LONG_NAME): "File name too long",
+            ("scene", "gimbal_gyroscope", "motion", "--tol", "1e-3", "--horizon", "1e6"): "--horizon"}
+    for argv, word in says.items():
+        code, out, err, _ = run(list(argv))
+        assert code in (1, 2) and word in err and "omega" not in err, (argv, err)
+
+
+def test_every_command_under_a_seeded_fuzz(tmp_path, scratch, short_budgets):
+    outs = tmp_path / "outs"
+    outs.mkdir()
+    _junk_model(outs)
+    codes = []
+    for argv in every_command_lines(outs, 100):
+        code, out, err, dt = run(argv)
+        _holds(argv, code, out, err, dt, outs, scratch)
+        codes.append((argv[0], code))
+    assert {c for _, c in codes} >= {0, 2}
+    assert {cmd for cmd, _ in codes} == {"scene", "stability", "map", "sweep", "level-map", "tolerance", "forced",
+                                         "unbalance", "simulate", "campbell", "frequencies", "stability-map", "params"}
+
+
+def test_a_junk_model_folder_is_one_clean_line_every_time(tmp_path):
+    """gyro.load of a junk emitted folder fails naming its metadata.json, the same way
+    again in the same process (the half-imported package is not kept)."""
+    from gyro.errors import ParameterError
+
+    junk = _junk_model(tmp_path)
+    for _ in range(2):
+        with pytest.raises(ParameterError, match="metadata.json"):
+            load(junk)
+    assert not (junk / "__pycache__").exists()
+
+
+def test_a_model_file_that_fails_to_derive_says_one_line_and_leaves_nothing(tmp_path, monkeypatch):
+    """Derived once (the notice and the line), then cached as failed: one line, and no
+    __pycache__ beside the file or the module it imports."""
+    monkeypatch.setenv("GYRO_CACHE", str(tmp_path / "cache"))
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "helper.py").write_text("VALUE = 2\n")
+    (src / "broken.py").write_text("import helper\n\n\ndef build():\n    raise ValueError('no model here')\n")
+    errs = []
+    for _ in range(2):
+        code, out, err, dt = run(["params", str(src / "broken.py")])
+        assert code == 2 and out == "" and "no model here" in err.splitlines()[-1], err
+        errs.append([ln for ln in err.splitlines() if ln.strip()])
+    assert len(errs[1]) == 1 and errs[1][0] == errs[0][-1]
+    assert sorted(p.name for p in src.iterdir()) == ["broken.py", "helper.py"]
+
+
+def _signals_delivered():
+    """In the child before exec: SIGINT handled by default (a shell's background job ignores
+    it) and neither signal blocked (a mask the test process may carry from a library)."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
+
+
+@pytest.mark.parametrize("sig, code", [("SIGTERM", 143), ("SIGINT", 130)])
+def test_a_stopped_tolerance_leaves_no_temporary_folder(tmp_path, sig, code):
+    """A study large enough for its on-disk arrays (the threshold lowered here), stopped
+    while it runs: one line, the signal's exit code, and the temporary folder empty."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    scratch = tmp_path / "tmpdir"
+    scratch.mkdir()
+    driver = ("import sys\nimport gyro.analyses.tolerance as t\nt.IN_MEMORY = 1000\nfrom gyro.cli import main\n"
+              "sys.exit(main(['tolerance', 'torsion_gyrocompass', '--spread', 'Kp=normal:0.05', "
+              "'--samples', '400000', '--quiet']))\n")
+    p = subprocess.Popen([sys.executable, "-c", driver], env=dict(os.environ, TMPDIR=str(scratch)),
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         preexec_fn=_signals_delivered)
+    t0 = time.monotonic()
+    while not any(scratch.iterdir()) and p.poll() is None and time.monotonic() - t0 < 60:
+        time.sleep(0.05)  # until the study's folder is there: stopped while it runs
+    assert p.poll() is None, p.communicate()
+    p.send_signal(getattr(signal, sig))
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == code and out == "" and len(err.strip().splitlines()) == 1, (p.returncode, err)
+    assert not any(scratch.iterdir()), sorted(scratch.iterdir())

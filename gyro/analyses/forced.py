@@ -85,10 +85,15 @@ def forced_response(model: Model, P, harmonics, method: str = "default") -> Forc
     X = np.full((P.shape[0], H, n), np.nan + 0j)
     res = np.zeros((P.shape[0], H), bool)
     wn, est = spec.frequencies, spec.error_estimate
+    # a set without a finite spin rate (no equilibrium, or H and C too far apart for a
+    # double) has no forcing frequency: no response there, never an error about an input
+    # (omega) the user did not give
+    spinning = np.isfinite(W) & (W >= 0)
     for j, (s, k, a, phi) in enumerate(harmonics):
         u = np.zeros((P.shape[0], 3), complex)
         u[:, s - 1] = -1j * a * np.exp(1j * phi)
-        r = harmonic_response(model, P, k * W, u, qe=qe)
+        r = harmonic_response(model, P, np.where(spinning, k * W, 0.0), u,
+                              qe=np.where(spinning[:, None], qe, np.nan))
         with np.errstate(invalid="ignore"):
             hit = np.any(np.abs(k * W[:, None] - wn) <= est * wn, axis=1) & undamped
         X[:, j], res[:, j] = r.X, r.resonance | hit

@@ -534,11 +534,11 @@ def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, at
 
         sym = ode.symbolic(load(MODEL))
         y, ydot = sym.y, ca.substitute(sym.ydot, sym.p, ca.DM(P))
-        opts = {"abstol": atol, "reltol": rtol, "max_num_steps": budget_steps,
-                "disable_internal_warnings": True}  # SUNDIALS' own lines on stderr: the error says it
+        opts = {"abstol": atol, "reltol": rtol, "max_num_steps": budget_steps, **ode.CASADI_QUIET}
         F = ca.integrator("F", method, {"x": y, "ode": ydot}, t[0], t, opts)
         try:
-            Y = np.array(F(x0=y0)["xf"]).T
+            with ode.stderr_silenced():  # SUNDIALS' error lines (IDAS prints them whatever the options)
+                Y = np.array(F(x0=y0)["xf"]).T
         except RuntimeError as exc:  # SUNDIALS gives up (its step budget, or a failed step)
             why = "its step budget" if "MXSTEP" in str(exc) or "mxstep" in str(exc).lower() else "a failed step"
             raise IntegrationBudget(f"{method} stopped before t = {t[-1]:.6g} s ({why})") from None

@@ -440,18 +440,20 @@ def integrate(values: dict, y0: np.ndarray, t: np.ndarray, method: str = "DOP853
             raise FloatingPointError(f"{method}: {sol.message}")
         return sol.y.T
     if method in CASADI_METHODS:
+        from gyro.ode import CASADI_QUIET, stderr_silenced
+
         ca, y, p, ydot, _ = _casadi_rhs()
         ode = ca.substitute(ydot, p, ca.DM(P))
         # SUNDIALS counts steps between output times; no budget (a library call): SUNDIALS' own
         # ceiling (inf // k is NaN, and max(500, NaN) was 500 steps an interval)
         per = 10**9 if math.isinf(max_steps) else max(500, max_steps // max(1, len(t) - 1))
-        opts = {"abstol": atol, "reltol": rtol, "max_num_steps": int(min(per, 10**9)),
-                "disable_internal_warnings": True}  # SUNDIALS' own lines on stderr: the error says it
+        opts = {"abstol": atol, "reltol": rtol, "max_num_steps": int(min(per, 10**9)), **CASADI_QUIET}
         if method == "cvodes-adams":  # non-stiff: Adams-Moulton with fixed-point iteration
             opts.update(linear_multistep_method="adams", nonlinear_solver_iteration="functional")
         F = ca.integrator("F", "cvodes", {"x": y, "ode": ode}, t[0], t[1:], opts)
         try:
-            Y = np.array(F(x0=y0)["xf"]).T
+            with stderr_silenced():  # SUNDIALS' error lines: the error below says it
+                Y = np.array(F(x0=y0)["xf"]).T
         except RuntimeError:  # SUNDIALS gives up (its step budget, or a failed step)
             raise IntegrationBudget(f"{method} stopped before t = {t[-1]:.6g} s (its budget of "
                                     f"{opts['max_num_steps']:.3g} steps between output times, or a failed step)") from None

@@ -208,10 +208,15 @@ def unbalance_response(model: Model, values: dict, force_x: str, force_y: str, m
         W = spin_rates(model, spin, P[sl])
         u = np.zeros((len(W), len(names)), complex)
         rot = magnitude * W**2 * np.exp(1j * phase)
-        u[:, names.index(force_x)] = rot
-        u[:, names.index(force_y)] = -1j * rot  # sin(W t + PHI) = Re(-i e^{i(W t + PHI)})
-        qe = np.where(ok[:, None], qe, np.nan)
-        parts.append(harmonic_response(model, P[sl], W, u, qe=qe))
+        # a spin value whose rate or force is beyond a double (ME W^2 at W = 1e300) has no
+        # response, as one without an equilibrium: never an error about an internal input
+        fine = np.isfinite(W) & (W >= 0) & np.isfinite(rot)
+        u[:, names.index(force_x)] = np.where(fine, rot, 0)
+        u[:, names.index(force_y)] = np.where(fine, -1j * rot, 0)  # sin(W t + PHI) = Re(-i e^{i(W t + PHI)})
+        qe = np.where((ok & fine)[:, None], qe, np.nan)
+        part = harmonic_response(model, P[sl], np.where(fine, W, 0.0), u, qe=qe)
+        part.omega = np.where(fine, W, np.nan)  # no rate shown where there is none
+        parts.append(part)
     unit = next(p.unit for p in model.params if p.name == spin)
     out = HarmonicResponse.concat(parts)
     out.x, out.xname, out.xunit = xs, spin, unit

@@ -30,7 +30,7 @@ import numpy as np
 
 from gyro import executor, ladder
 from gyro.analyses.sweep import model_ref, warm
-from gyro.errors import ParameterError
+from gyro.errors import ParameterError, terminable
 from gyro.models import Model, load
 from gyro.results import ToleranceStudy
 
@@ -85,7 +85,11 @@ def correlation(spreads: list[Spread], pairs: dict) -> np.ndarray:
     """The copula's correlation matrix from {(A, B): rho}; positive definite or refused."""
     names = [s.name for s in spreads]
     c = np.eye(len(spreads))
+    seen = set()
     for (a, b), rho in pairs.items():
+        if frozenset((a, b)) in seen:  # A,B and B,A: two values for one correlation
+            raise ParameterError(f"--correlate {a},{b}: the pair is given twice")
+        seen.add(frozenset((a, b)))
         for x in (a, b):
             if x not in names:
                 raise ParameterError(f"--correlate {a},{b}: {x} has no --spread")
@@ -182,6 +186,8 @@ def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: i
     spreads = [Spread(model.param_name(s.name, "--spread"), s.kind, s.width) for s in spreads]
     pairs = {(model.canonical(a), model.canonical(b)): rho for (a, b), rho in (pairs or {}).items()}
     names = [s.name for s in spreads]
+    if not 2 <= n:
+        raise ParameterError(f"--samples: need at least 2 (one sample has no standard deviation), got {n}")
     for s in spreads:
         if values[s.name] == 0:
             raise ParameterError(f"--spread {s.name}: its value is 0, so a relative spread moves nothing")
@@ -200,6 +206,7 @@ def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: i
     relwidth = np.array([s.width for s in spreads])
     uniform = np.array([s.kind == "uniform" for s in spreads])
     nomspec = ladder.spectrum(model, nominal, "default")
+    ladder.require_finite(model, nomspec, "the nominal set")  # nothing to spread: refused before sampling
     sens = sensitivities(model, nominal, nomspec)
     # first order
     sd = np.array([s.std for s in spreads]) * nominal[index]
@@ -207,27 +214,27 @@ def tolerance(model: Model, values: dict, spreads: list[Spread], n: int, seed: i
     S = sens.d[0][:, index]
     first_std = np.sqrt(np.einsum("ij,jk,ik->i", S, cov, S))
     nmodes = nomspec.frequencies.shape[1]
-    folder = store
-    tmp = None
-    if folder is None and n * (nmodes + 1) * 8 > IN_MEMORY:
-        tmp = tempfile.TemporaryDirectory(prefix="gyro-tolerance-")
-        folder = Path(tmp.name)
-    try:
-        ref = model_ref(model)
-        out = executor.run(chunk, n, size, (ref, nominal, index, relwidth, uniform, chol, seed), scheduler,
-                           folder, progress, "tolerance", warm=warm, warm_args=(ref,))
-        F = out["frequencies"]
-        ok = np.all(np.isfinite(F), axis=1)
-        stats = _stats(F, ok)
-        bands = None
-        if harmonics:
-            spin = out["spin"]
-            bands = _bands(F, ok, spin, harmonics, band, nomspec.frequencies[0], sens.d[0], model, nominal, cov,
-                           index)
-    finally:
-        if tmp is not None:
-            del F, out
-            tmp.cleanup()
+    folder, tmp, out, F = store, None, None, None
+    with terminable():  # SIGTERM as Ctrl-C here: the chunks return to Python often
+        try:  # the temporary folder made inside: Ctrl-C, SIGTERM or MemoryError after finds it
+            if folder is None and n * (nmodes + 1) * 8 > IN_MEMORY:
+                tmp = tempfile.TemporaryDirectory(prefix="gyro-tolerance-")
+                folder = Path(tmp.name)
+            ref = model_ref(model)
+            out = executor.run(chunk, n, size, (ref, nominal, index, relwidth, uniform, chol, seed), scheduler,
+                               folder, progress, "tolerance", warm=warm, warm_args=(ref,))
+            F = out["frequencies"]
+            ok = np.all(np.isfinite(F), axis=1)
+            stats = _stats(F, ok)
+            bands = None
+            if harmonics:
+                spin = out["spin"]
+                bands = _bands(F, ok, spin, harmonics, band, nomspec.frequencies[0], sens.d[0], model, nominal, cov,
+                               index)
+        finally:
+            if tmp is not None:
+                out = F = None  # the memory maps closed before their folder goes
+                tmp.cleanup()
     return ToleranceStudy(model.name, model.meta["title"], n, seed, [s.__dict__ for s in spreads],
                           {f"{a},{b}": r for (a, b), r in (pairs or {}).items()},
                           nomspec.frequencies[0], sens, index, first_std, int(np.sum(~ok)), *stats,
@@ -249,7 +256,8 @@ def _stats(F, ok):
         col = np.asarray(F[:, i])[idx]  # one column at a time: a memory map is read in strides
         mean[i] = col.mean()
         dev = col - mean[i]
-        std[i] = np.sqrt(np.mean(dev**2) * idx.size / max(idx.size - 1, 1))
+        # one answered sample has no spread: its std stays NaN (shown as none), never 0
+        std[i] = np.sqrt(np.mean(dev**2) * idx.size / (idx.size - 1)) if idx.size > 1 else np.nan
         if std[i] > 0:
             skew[i] = np.mean(dev**3) / std[i] ** 3
             kurt[i] = np.mean(dev**4) / std[i] ** 4

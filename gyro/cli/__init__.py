@@ -25,8 +25,8 @@ import importlib
 import pkgutil
 import sys
 
-from gyro.cli.common import EXIT_USAGE, Parser
-from gyro.errors import ParameterError
+from gyro.cli.common import COMMAND_BUDGET, EXIT_USAGE, Parser
+from gyro.errors import ParameterError, Terminated
 
 
 def commands() -> list:
@@ -68,23 +68,28 @@ def main(argv=None) -> int:
         return _interrupted()
     import numpy as np  # after parsing: `gyro --help` and usage errors import no NumPy
 
+    from gyro import executor
     from gyro.equilibrium import EquilibriumError
 
     try:
-        with np.errstate(all="ignore"), _stdout_for_results_only():  # failures: one line each
-            return args.run(args)
+        with np.errstate(all="ignore"), _stdout_for_results_only(), _quiet_libraries(), \
+                executor.budget(COMMAND_BUDGET):
+            return args.run(args)  # failures: one line each
+    except Terminated:
+        print("gyro: terminated", file=sys.stderr)
+        return EXIT_TERMINATED
     except KeyboardInterrupt:
         return _interrupted()
     except ParameterError as exc:
-        print(f"gyro: error: {exc}", file=sys.stderr)
+        print(f"gyro: error: {_plain(str(exc))}", file=sys.stderr)
         return EXIT_USAGE
     except EquilibriumError as exc:
-        print(f"gyro: error: no equilibrium found: {exc}", file=sys.stderr)
+        print(f"gyro: error: no equilibrium found: {_plain(str(exc))}", file=sys.stderr)
         return 1
     except (np.linalg.LinAlgError, ArithmeticError, ValueError, RuntimeError) as exc:
         # valid input whose numbers the solvers cannot handle (e.g. 1e300), an integrator
         # that gives up, mpmath without convergence
-        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        msg = _plain(str(exc).splitlines()[0]) if str(exc) else type(exc).__name__
         print(f"gyro: error: numerical failure at these parameters ({msg})", file=sys.stderr)
         return 1
     except BrokenPipeError:  # output closed early (e.g. piped into head)
@@ -107,6 +112,47 @@ def main(argv=None) -> int:
 def _interrupted() -> int:
     print("gyro: interrupted", file=sys.stderr)
     return 130
+
+
+EXIT_TERMINATED = 143  # 128 + SIGTERM, as a shell reports a process the signal ended
+
+
+class _quiet_libraries:
+    """While a command runs, no library's warning reaches stderr (matplotlib's layout and
+    log-axis notices, Dask's port and memory notices, as warnings or as log records): gyro
+    issues no warning of its own, a command says what went wrong in its own one line, and a
+    result it cannot stand behind is refused, not printed beside a warning."""
+
+    LIBRARIES = ("matplotlib", "dask", "distributed", "tornado", "bokeh")
+
+    def __enter__(self):
+        import logging
+        import warnings
+
+        self.catch = warnings.catch_warnings()
+        self.catch.__enter__()
+        warnings.simplefilter("ignore")
+        self.levels = {}
+        for lib in self.LIBRARIES:
+            log = logging.getLogger(lib)
+            self.levels[lib] = log.level
+            log.setLevel(logging.CRITICAL + 1)
+        return self
+
+    def __exit__(self, *exc):
+        import logging
+
+        for lib, level in self.levels.items():
+            logging.getLogger(lib).setLevel(level)
+        self.catch.__exit__(*exc)
+        return False
+
+
+def _plain(message: str) -> str:
+    """A message with NumPy's scalar reprs (np.float64(0.5), numpy 2) as plain numbers."""
+    import re
+
+    return re.sub(r"np\.(?:float|int|uint|complex|bool_?)\d*\(([^()]*)\)", r"\1", message)
 
 
 class _stdout_for_results_only:

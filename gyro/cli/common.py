@@ -10,6 +10,9 @@ from pathlib import Path
 from gyro.errors import ParameterError
 
 EXIT_USAGE = 2
+COMMAND_BUDGET = 60.0  # s: a command's batch in this process (gyro.executor.budget), refused beyond
+MAX_NAME = 200  # bytes of an output's file name: the temporary beside it adds its own tag
+MAX_PATH = 4000  # bytes of a path (PATH_MAX is 4096 on Linux)
 SET_HELP = "parameter value in SI units (phi in degrees); repeat as needed"
 
 
@@ -38,7 +41,11 @@ def add_model(p, models=None, help="the model (gyro params MODEL lists its param
         if text in known:
             return text
         if models is None:  # any model: a generated one, an emitted folder or a model file
-            if model_source(text) is not None:
+            try:
+                found = model_source(text)
+            except ParameterError as exc:  # a path the system cannot take (too long a name)
+                raise argparse.ArgumentTypeError(str(exc)) from None
+            if found is not None:
                 return text
             raise argparse.ArgumentTypeError(f"unknown model {text!r}: not one of {', '.join(known)}, nor a "
                                              "model file PATH.py, nor an emitted folder DIR/<name>")
@@ -56,8 +63,20 @@ def add_json(p) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
-def add_out(p, required: bool = True, help: str | None = "image to write") -> None:
-    p.add_argument("--out", required=required, metavar="FILE.png", help=help)
+def out_name(text: str) -> str:
+    """An output file's name as argparse's type: refused in the parse when empty (an empty
+    --out would be taken for no --out) or longer than a file name can be."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("empty: name the file to write")
+    name = Path(text).name
+    if len(name.encode(errors="surrogateescape")) > MAX_NAME or len(os.fsencode(text)) > MAX_PATH:
+        raise argparse.ArgumentTypeError(f"the file name is too long ({len(name.encode(errors='surrogateescape'))} "
+                                         f"bytes; at most {MAX_NAME}, the path at most {MAX_PATH})")
+    return text
+
+
+def add_out(p, required: bool = True, help: str | None = "image to write", flag: str = "--out") -> None:
+    p.add_argument(flag, required=required, type=out_name, metavar="FILE.png", help=help)
 
 
 def add_points(p, default, help: str | None = None, type=int) -> None:
@@ -96,18 +115,58 @@ def model_with_equilibrium(name):
     return model
 
 
-def check_png_out(path) -> Path:
-    """A figure's --out: a .png in a folder that exists and is writable."""
+def check_png_out(path, flag: str = "--out") -> Path:
+    """A figure's --out: a .png in a folder that exists and where a file can be created,
+    checked before anything is computed (by creating and removing a probe file there: a
+    permission bit says nothing for root, nor for a read-only or pseudo file system)."""
+    try:
+        out_name(str(path))
+    except argparse.ArgumentTypeError as exc:
+        raise ParameterError(f"{flag}: {exc}") from None
     out = Path(path)
     if out.suffix.lower() != ".png":
-        raise ParameterError(f"--out {path!r}: the figure is written as PNG; name it *.png")
-    if out.is_dir():
-        raise ParameterError(f"--out {path!r}: is a folder; name the file")
-    if len(out.name.encode()) > 200:  # the temporary beside it adds its own tag to the name
-        raise ParameterError(f"--out: the file name is too long ({len(out.name.encode())} bytes; at most 200)")
-    parent = out.resolve().parent
-    if not parent.is_dir():
-        raise ParameterError(f"--out {path!r}: folder {parent} does not exist")
-    if not os.access(parent, os.W_OK):
-        raise ParameterError(f"--out {path!r}: folder {parent} is not writable")
+        raise ParameterError(f"{flag} {path!r}: the figure is written as PNG; name it *.png")
+    try:
+        if out.is_dir():
+            raise ParameterError(f"{flag} {path!r}: is a folder; name the file")
+        parent = out.resolve().parent
+        if not parent.is_dir():
+            raise ParameterError(f"{flag} {path!r}: folder {parent} does not exist")
+    except OSError as exc:
+        raise ParameterError(f"{flag} {path!r}: {exc.strerror or exc}") from None
+    writable_folder(flag, path, parent)
     return out
+
+
+def writable_folder(flag: str, path, folder: Path) -> None:
+    """ParameterError naming `flag` unless a file can be created in `folder` (tried: a probe
+    file created and removed at once, nothing left)."""
+    import tempfile
+
+    try:
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".gyro-probe-"):
+            pass
+    except OSError as exc:
+        raise ParameterError(f"{flag} {str(path)!r}: cannot write in {folder} ({exc.strerror or exc})") from None
+
+
+def refuse_over_budget(flag: str, count: int, each: float, scheduler=None, what: str = "sets",
+                       cluster: bool = True) -> None:
+    """Before anything runs: ParameterError naming `flag` when `count` items at `each`
+    seconds apiece (measured: a method's COST, compiled) cannot fit the command line's
+    budget in this process. On a --scheduler the cluster is the user's, and nothing is
+    refused here."""
+    if scheduler is None and count * each > COMMAND_BUDGET:
+        raise ParameterError(f"{flag}: {count} {what} take about {count * each:.0f} s in this process "
+                             f"({f'{each:.3g} s' if each >= 0.01 else f'{each * 1e6:.3g} us'} each), over the "
+                             "command line's budget of "
+                             f"{COMMAND_BUDGET:.0f} s: ask for fewer" + (", or use --scheduler" if cluster else ""))
+
+
+def method_cost(name: str) -> float:
+    """A frequency method's COST (s per set, compiled, measured), read from its source
+    without importing it."""
+    from gyro.catalog import module_constants
+    from gyro.methods import __path__ as folder
+
+    return float(module_constants(folder[0], ("COST",))[name]["COST"])

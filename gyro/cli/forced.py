@@ -38,7 +38,8 @@ def run(args) -> int:
     result = forced_response(model, model.vector(values), harmonics)
     doc = result.to_dict(0)
     if not all(a is not None or h["resonance"] for h in doc["harmonics"] for a in h["amplitudes"]):
-        raise RuntimeError("no finite response at these parameters (no equilibrium or operator)")
+        given = " ".join(f"--set {k}={v}" for k, v in parse_sets(args.set).items()) or "the paper's set"
+        raise RuntimeError(f"no finite steady response: no equilibrium, spin rate or operator at {given}")
     if out is not None:
         result.plot(out)
     if args.json:

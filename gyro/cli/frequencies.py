@@ -37,14 +37,13 @@ def run(args) -> int:
     if args.modes and args.method == "formulas":
         raise ParameterError("--modes: the formulas give frequencies only; use another --method")
     spec = ladder.spectrum(model, model.vector(values), args.method, modes=args.modes)
-    if not (np.all(np.isfinite(spec.frequencies[0])) and np.all(np.isfinite(spec.growth[0]))):
-        if spec.equilibrium is not None and not np.all(np.isfinite(spec.equilibrium[0])):
-            from gyro.equilibrium import EquilibriumError, unbalanced
+    if spec.equilibrium is not None and not np.all(np.isfinite(spec.equilibrium[0])):
+        from gyro.equilibrium import EquilibriumError, unbalanced
 
-            reason = unbalanced(model, model.vector(values))
-            if reason:  # no equilibrium: one line naming the residual
-                raise EquilibriumError(reason)
-        raise FloatingPointError("a frequency is not finite")  # no verdict: exit 1, text and JSON alike
+        reason = unbalanced(model, model.vector(values))
+        if reason:  # no equilibrium: one line naming the residual
+            raise EquilibriumError(reason)
+    ladder.require_finite(model, spec)  # no verdict: exit 1, text and JSON alike
     sens = None
     if getattr(args, "sensitivities", False):
         if args.method == "formulas":

@@ -12,7 +12,8 @@ from __future__ import annotations
 import json
 import sys
 
-from gyro.cli.common import add_json, add_model, add_out, add_quiet, add_set, check_png_out, parse_sets
+from gyro.cli.common import (add_json, add_model, add_out, add_quiet, add_set, check_png_out, parse_sets,
+                             refuse_over_budget)
 from gyro.errors import ParameterError, finite_number
 
 ORDER = 36
@@ -51,6 +52,8 @@ def run(args) -> int:
     tol = finite_number("--tol", args.tol)
     if not 0 < tol < 1:
         raise ParameterError(f"--tol must lie in (0, 1), got {args.tol!r}")
+    refuse_over_budget("--x, --y", xaxis[3] * yaxis[3], _cost(model, args.level, args.against), what="grid points",
+                       cluster=False)
     out = check_png_out(args.out)
     sets = {model.canonical(k): finite_number(f"parameter {k}", v) for k, v in parse_sets(args.set).items()}
     model.parameters(sets)  # every name and value checked before anything runs
@@ -59,3 +62,14 @@ def run(args) -> int:
     grid.plot(out)
     print(json.dumps(grid.to_dict(), allow_nan=False) if args.json else grid.summary(out))
     return 0
+
+
+def _cost(model, level: str, against: str) -> float:
+    """Seconds a grid point costs: the two levels' measured costs per set (the hierarchy's
+    declared ones); 0 where a level has none measured (nothing to refuse on)."""
+    import math
+
+    from gyro.levels import get
+
+    each = sum(get(model, name).cost for name in (level, against))
+    return each if math.isfinite(each) else 0.0

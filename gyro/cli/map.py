@@ -11,11 +11,12 @@ from __future__ import annotations
 
 import json
 
-from gyro.cli.common import add_json, add_model, add_out, add_set, check_png_out, parse_sets
+from gyro.cli.common import add_json, add_model, add_out, add_set, check_png_out, parse_sets, refuse_over_budget
 from gyro.errors import ParameterError
 
 ORDER = 33
 MODELS = ("gyrohorizoncompass",)
+POINT_COST = 1.8e-4  # s a grid point (100 x 100 in 1.8 s, measured; 1000 x 1000 would be 3 min)
 
 
 def register(sub) -> None:
@@ -42,6 +43,7 @@ def run(args) -> int:
     for axis in (xaxis, yaxis):
         if axis[0] in sets:
             raise ParameterError(f"parameter {axis[0]}: is an axis; do not --set it")
+    refuse_over_budget("--x, --y", xaxis[3] * yaxis[3], POINT_COST, what="grid points", cluster=False)
     out = check_png_out(args.out)
     values = parameters(sets, orbit=args.orbit, need_equilibrium=False)  # each point is checked
     grid = condition_map(values, xaxis, yaxis, orbit=args.orbit, lambda_follows="lambda" not in sets)

@@ -32,11 +32,51 @@ def register(sub) -> None:
     f.set_defaults(run=run)
 
 
+EPS = 2.220446049250313e-16  # a double's relative rounding: no answer printed as one is closer
+MAX_PERIODS = 10_000  # of the fastest motion over a motion's horizon (the gyrohorizoncompass's
+# linear level: 350 periods of omega4 = 219.6 rad/s in 6 s, 3500 in 28 s, measured)
+
+
 def _tol(text: str) -> float:
     tol = finite_number("--tol", text)
     if not 0 < tol < 1:
         raise ParameterError(f"--tol: must lie in (0, 1), got {text!r}")
     return tol
+
+
+def _check_motion_tol(tol: float, text: str) -> None:
+    """A motion is integrated in doubles by every level (the frequencies have a 40-digit
+    level, the motion none): a tolerance below a double's rounding is refused at once, not
+    after every level has tried (38 s at 1e-30)."""
+    if tol < EPS:
+        raise ParameterError(f"--tol {text}: below a double's rounding ({EPS:.2g}), which bounds every "
+                             "level of a motion (each integrates in doubles)")
+
+
+def _fastest(model, vector, initial: dict, extra: dict) -> float:
+    """The fastest rate of the motion in rad/s: the largest natural frequency about the
+    equilibrium (a model that has one) and the largest initial rate given in rad/s."""
+    import numpy as np
+
+    rates = [abs(v) for k, v in initial.items() if extra[k][0] == "rad/s"]
+    if not model.meta.get("momenta"):
+        from gyro import ladder
+
+        w = ladder.spectrum(model, vector, "default").frequencies[0]
+        rates += [float(np.max(w))] if np.all(np.isfinite(w)) else []
+    return max(rates, default=0.0)
+
+
+def _check_horizon(model, vector, initial: dict, extra: dict, horizon: float) -> None:
+    """A horizon's predictable cost: its periods of the fastest motion, refused beyond
+    MAX_PERIODS before any level runs (--horizon 1e6: 52-77 s before, then no answer)."""
+    import math
+
+    w = _fastest(model, vector, {**{k: d[1] for k, d in extra.items()}, **initial}, extra)
+    periods = horizon * w / (2 * math.pi)
+    if periods > MAX_PERIODS:
+        raise ParameterError(f"--horizon {horizon:g}: {periods:.3g} periods of the fastest motion ({w:.4g} rad/s), "
+                             f"over the {MAX_PERIODS} a motion question takes; a shorter horizon")
 
 
 def _modes(text: str | None) -> list | None:
@@ -85,6 +125,10 @@ def run(args) -> int:
         opts["harmonic"] = parse_harmonic(args.harmonic)
     elif args.question == "forced":
         raise ParameterError("--harmonic: the forced question needs one harmonic S:K:AMP[:PHASE]")
+    if args.question == "motion":
+        _check_motion_tol(tol, args.tol)
+    if "horizon" in opts:
+        _check_horizon(model, model.vector(values), opts.get("initial", {}), extra, opts["horizon"])
     scene = select(model, args.question, model.vector(values), tol, opts)
     if not scene.answered[0]:
         b, lv = scene.best(0)

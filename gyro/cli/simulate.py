@@ -35,7 +35,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from gyro.cli.common import add_json, add_model, add_set, check_png_out, parse_sets
+from gyro.cli.common import add_json, add_model, add_out, add_set, check_png_out, parse_sets
 from gyro.errors import ParameterError, finite_number
 
 ORDER = 50
@@ -64,7 +64,7 @@ def register(sub) -> None:
                    help="gimbal_precession: a time-varying base, u_NAME(t) = u_NAME + AMP sin(FREQ t + PHASE) "
                    "(NAME xi, eta or zeta; AMP in rad/s, FREQ >= 0 in rad/s, PHASE in rad, default 0); repeatable")
     add_json(s)
-    s.add_argument("--out", metavar="FILE.png", help="also plot the coordinates against t into FILE.png")
+    add_out(s, required=False, help="also plot the coordinates against t into FILE.png")
     s.set_defaults(run=run)
 
 

@@ -52,6 +52,10 @@ def run(args) -> int:
     out = check_png_out(args.out) if args.out else None
     result = sweep(model, values, args.x, lo, hi, args.points, args.method, args.x_log,
                    progress=not args.quiet and sys.stderr.isatty(), scheduler=args.scheduler)
+    if not np.any(np.all(np.isfinite(result.spectrum.frequencies), axis=1)):  # no table of nothing: one line
+        from gyro.ladder import require_finite
+
+        require_finite(model, result.spectrum, f"any {args.x} of the sweep")
     if out is not None:
         result.plot(out)
     if args.json:

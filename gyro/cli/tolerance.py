@@ -8,7 +8,8 @@ import json
 import sys
 
 from gyro.cli.common import (add_json, add_model, add_out, add_quiet, add_scheduler, add_set, check_png_out,
-                             model_with_equilibrium, parse_sets)
+                             method_cost, model_with_equilibrium, parse_sets, refuse_over_budget,
+                             writable_folder)
 from gyro.errors import ParameterError
 
 ORDER = 37
@@ -33,7 +34,7 @@ def register(sub) -> None:
                    help="keep the sampled frequencies as .npy files in DIR (written chunk by chunk)")
     add_json(t)
     add_out(t, required=False, help="histograms of the frequencies with the first-order normal, FILE.png")
-    t.add_argument("--tornado", default=None, metavar="FILE.png", help="a tornado chart of the sensitivities")
+    add_out(t, required=False, help="a tornado chart of the sensitivities", flag="--tornado")
     add_quiet(t)
     t.set_defaults(run=run)
 
@@ -49,7 +50,10 @@ def parse_pairs(items) -> dict:
             r = None
         if not sep or not sep2 or r is None:
             raise ParameterError(f"--correlate {item!r}: expected A,B=RHO")
-        out[(a.strip(), b.strip())] = r
+        key = (a.strip(), b.strip())
+        if key in out or key[::-1] in out:  # as a repeated --spread: never the last one silently
+            raise ParameterError(f"--correlate {key[0]},{key[1]}: the pair is given twice")
+        out[key] = r
     return out
 
 
@@ -74,17 +78,24 @@ def run(args) -> int:
     model = model_with_equilibrium(args.model)
     values = model.parameters(parse_sets(args.set))
     spreads = [parse_spread(s) for s in args.spread]
-    if not 1 <= args.samples <= MAX_SAMPLES:
-        raise ParameterError(f"--samples: need 1..{MAX_SAMPLES}, got {args.samples}")
+    if not 2 <= args.samples <= MAX_SAMPLES:  # one sample has no spread: no std to report
+        raise ParameterError(f"--samples: need 2..{MAX_SAMPLES} (one sample has no standard deviation), "
+                             f"got {args.samples}")
+    refuse_over_budget("--samples", args.samples, method_cost("default"), args.scheduler, "samples")
     if not (math.isfinite(args.band) and 0 < args.band < 1):
         raise ParameterError(f"--band: need 0 < REL < 1, got {args.band}")
     if not 0 <= args.seed < 2**63:
         raise ParameterError(f"--seed: need 0 <= S < 2^63, got {args.seed}")
     out = check_png_out(args.out) if args.out else None
-    tornado = check_png_out(args.tornado) if args.tornado else None
+    tornado = check_png_out(args.tornado, "--tornado") if args.tornado else None
     store = Path(args.store) if args.store else None
     if store is not None and store.exists() and not store.is_dir():
         raise ParameterError(f"--store {args.store!r}: not a folder")
+    if store is not None:  # tried before sampling: the folder, or the nearest one it will be made in
+        where = store.resolve()
+        while not where.is_dir() and where != where.parent:
+            where = where.parent
+        writable_folder("--store", args.store, where)
     study = tolerance(model, values, spreads, args.samples, args.seed, parse_pairs(args.correlate),
                       args.scheduler, parse_harmonics(args.harmonics), args.band, store,
                       progress=not args.quiet and sys.stderr.isatty())

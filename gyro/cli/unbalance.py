@@ -40,6 +40,7 @@ def run(args) -> int:
     from gyro.analyses.spin import spin_parameter
     from gyro.errors import ParameterError
     from gyro.models import load
+    from gyro.results._io import cell
 
     model = load(args.model)
     require_inputs(model)
@@ -57,7 +58,8 @@ def run(args) -> int:
                                 spin, lo, hi, args.points, progress=not args.quiet and sys.stderr.isatty())
     bad = ~np.all(np.isfinite(result.X), axis=1) & ~result.resonance
     if bad.all():
-        raise RuntimeError("no equilibrium over the whole spin range")
+        raise RuntimeError("no finite response over the whole spin range (no equilibrium, or the force "
+                           "ME W^2 beyond a double)")
     if out is not None:
         result.plot(out)
     if args.json:
@@ -70,13 +72,14 @@ def run(args) -> int:
                                                                for c, u in zip(result.coordinates, result.units)))
         rows = range(len(result)) if len(result) <= 21 else np.unique(np.linspace(0, len(result) - 1, 11).round().astype(int))
         for i in rows:
-            cells = ["resonance" if result.resonance[i] else f"{a:.6g}" for a in amp[i]]
-            print(f"{i + 1:>4} {result.x[i]:>12.6g} {result.omega[i]:>12.6g} " + " ".join(f"{c:>14}" for c in cells))
+            cells = ["resonance" if result.resonance[i] else cell(a, ".6g") for a in amp[i]]
+            print(f"{i + 1:>4} {result.x[i]:>12.6g} {cell(result.omega[i], '>12.6g')} " + " ".join(f"{c:>14}" for c in cells))
         if len(result) > 21:
             print(f"({len(result)} points; 11 shown; --json prints all)")
         if out is not None:
             print(result.summary(out))
     if bad.any():
-        print(f"gyro: {int(bad.sum())} spin values have no equilibrium (null in the JSON)", file=sys.stderr)
+        print(f"gyro: {int(bad.sum())} spin values have no finite response (no equilibrium, or the force beyond "
+              "a double; null in the JSON)", file=sys.stderr)
         return 1
     return 0

@@ -176,3 +176,16 @@ def mode_panels(plt, n: int, height: float):
     for ax in axes.flat[n:]:
         ax.axis("off")
     return fig, axes
+
+
+def cell(x, spec: str, none: str = "none") -> str:
+    """One number of a text table formatted by `spec` (as '>12.6g'), or, where it is NaN or
+    infinite, the word `none` in the same width: a table never prints nan or inf as if it
+    were a number (the caller says in a note what the word means)."""
+    import math
+
+    if x is not None and math.isfinite(x):
+        return format(x, spec)
+    width = "".join(ch for ch in spec.split(".")[0] if ch.isdigit())
+    align = "<" if spec.startswith("<") else ">"
+    return format(none, f"{align}{width}") if width else none

@@ -72,7 +72,7 @@ class HarmonicResponse(_Amplitudes, Result):
     def to_dict(self) -> dict:
         """The `gyro unbalance --json` document (keys of its contract), plus `resonance`."""
         return {"model": self.model, "spin": self.xname, "values": self.x.tolist(),
-                "spin_rate": self.omega.tolist(), "coordinates": list(self.coordinates),
+                "spin_rate": _finite_or_none(self.omega[None])[0], "coordinates": list(self.coordinates),
                 "units": list(self.units),
                 "amplitudes": _finite_or_none(np.where(self.resonance[:, None], np.nan, self.amplitudes)),
                 "phases": _finite_or_none(self.phases),

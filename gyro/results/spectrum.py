@@ -8,7 +8,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from gyro.results import verdict
-from gyro.results._io import Result, _pyplot
+from gyro.results._io import Result, _pyplot, cell
 
 
 @dataclass
@@ -107,11 +107,21 @@ class Spectrum(Result):
         zeta, delta = self.damping_ratio()[k], self.log_dec()[k]
         lam = np.abs(self.growth[k] + 1j * freqs)
         grows = (self.growth[k] > np.maximum(np.where(np.isfinite(est), est, np.inf), 1e-9) * lam) & np.isfinite(est)
+        words = set()  # what a word in a number's place means, said below the table
         for i, (w, e) in enumerate(zip(freqs, est), 1):
-            period = 2 * np.pi / w if w > 0 else float("inf")
-            row = f"{i:>4} {w:>16.9g} {w / (2 * np.pi):>14.6g} {period:>14.6g} {e:>14.2g}"
+            with np.errstate(divide="ignore", over="ignore"):
+                period = 2 * np.pi / w if w > 0 else np.nan
+            if not np.isfinite(w):
+                words.add("none")
+            elif not np.isfinite(period):
+                words.add("-" if w == 0 else "-slow")
+            if not np.isfinite(e):
+                words.add("unbounded")
+            row = (f"{i:>4} {cell(w, '>16.9g')} {cell(w / (2 * np.pi), '>14.6g')} {cell(period, '>14.6g', '-')} "
+                   f"{cell(e, '>14.2g', 'unbounded')}")
             if damped:
-                row += f" {zeta[i - 1]:>14.6g} {delta[i - 1]:>11.5g}"
+                row += f" {cell(zeta[i - 1], '>14.6g')} {cell(delta[i - 1], '>11.5g')}"
+                words |= {"none"} if not (np.isfinite(zeta[i - 1]) and np.isfinite(delta[i - 1])) else set()
             if grows[i - 1]:
                 row += f"   grows at {self.growth[k][i - 1]:.6g} 1/s"
             if self.steady is not None and self.steady[k, i - 1]:
@@ -127,6 +137,11 @@ class Spectrum(Result):
                             "up to 40 digits, bounds it; no verdict)"),
                 "failed": " (these parameters could not be computed)",
                 "boundary": f" (rounding could change the verdict: {stab.reason[k]})"}.get(label, "")
+        lines += [text for word, text in (
+            ("-", "period -: a zero root (omega = 0) has no period"),
+            ("-slow", "period -: omega so small that its period 2 pi/omega exceeds a double"),
+            ("unbounded", "unbounded: no bound on that root's relative error at these parameters"),
+            ("none", "none: no finite value at these parameters")) if word in words]
         lines.append(f"equilibrium: {label}{note}")
         return "\n".join(lines)
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gyro.results._io import _pyplot, mode_panels, save_figure
+from gyro.results._io import _pyplot, cell, mode_panels, save_figure
 from gyro.results.sensitivity import Sensitivities
 
 QUANTILE_LEVELS = (0.01, 0.5, 0.99)
@@ -119,9 +119,9 @@ class ToleranceStudy:
                 verdict = str(verdicts[i]) + (f" ({100 * err[i]:+.1f} %)" if np.isfinite(err[i]) else "")
             else:
                 verdict = "none (a double root at the nominal set)"
-            lines.append(f"{i + 1:>4} {self.nominal[i]:>12.6g} {self.mean[i]:>12.6g} {self.std[i]:>11.4g} "
-                         f"{self.first_order_std[i]:>13.4g} {self.quantiles[i, 0]:>12.6g} {self.quantiles[i, 2]:>12.6g}"
-                         f"  {verdict}")
+            lines.append(f"{i + 1:>4} {cell(self.nominal[i], '>12.6g')} {cell(self.mean[i], '>12.6g')} "
+                         f"{cell(self.std[i], '>11.4g')} {cell(self.first_order_std[i], '>13.4g')} "
+                         f"{cell(self.quantiles[i, 0], '>12.6g')} {cell(self.quantiles[i, 2], '>12.6g')}  {verdict}")
         if self.band_probability is not None:
             ks = ", ".join(str(k) for k in self.harmonics)
             lines.append(f"probability within +-{100 * self.band:g} % of a harmonic k omega_c, k = {ks} "

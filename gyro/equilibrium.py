@@ -294,6 +294,7 @@ def _solve(model: Model, P, q0, idx, is_angle, tol, max_iter):
 # miss by more than 1e-8 of their own terms is no equilibrium that rounding explains (the
 # cubic spring at x = 0 misses by all of its terms, ratio 1).
 RESIDUAL_TOL = 1e-8
+SUBNORMAL_FLOOR = 1e3 * np.finfo(float).tiny  # 2.2e-305: rows below it are zero (residual_test)
 # starts tried where Newton could not start: the first start moved by these fractions of
 # its own coordinates, or by these amounts in the coordinate's units where it is zero
 # (angles by at most 1 rad), each with alternating signs over the coordinates, then the
@@ -335,7 +336,10 @@ def residual_test(model: Model, P, qe, idx):
             Pall = np.concatenate([Pl * np.where(np.arange(npar) == j, 1 + h, 1.0) for j in range(npar)])
             rall = rows(Pall, np.tile(qe[late], (npar, 1))).reshape(npar, m, -1)
             T[late] += np.sum(np.abs(rall - r[late]), axis=0) / h
-        ratio = np.where(np.abs(r) == 0, 0.0, np.abs(r) / T)
+        # below the smallest normal double a residual has no relative precision left (a
+        # latitude of 2.2e-308 deg leaves rows of 1e-323 beside terms of 1e-318): such a
+        # residual is zero to double precision's range, whatever its ratio
+        ratio = np.where(np.abs(r) <= SUBNORMAL_FLOOR, 0.0, np.abs(r) / T)
     ratio = np.where(np.isfinite(ratio), ratio, np.inf)
     row = np.argmax(ratio, axis=1)
     k = np.arange(n)

@@ -85,8 +85,10 @@ def test_mmotor_and_m_motor_are_one_parameter(tmp_path):
     assert docs["Mmotor"]["params"]["Mmotor"] == docs["Mmotor"]["params"]["M_motor"] == 1e-4
     refused(*run, "--set", "Mmotor=1e-4", "--set", "M_motor=1e-4", word="Mmotor: given twice")
     refused(*run, "--set", "Mmotr=1e-4", word="M_motor for Mmotor")  # the known names, both
-    rc, a, _ = run_cli("sweep", "gimbal_precession", "--x", "M_motor", "--x-range", "0", "1e-3", "--points", "2",
-                       "--json")
-    rc2, b, _ = run_cli("sweep", "gimbal_precession", "--x", "Mmotor", "--x-range", "0", "1e-3", "--points", "2",
+    # the sweep has no equilibrium to answer about (the model turns steadily with no rest
+    # point in the motor's range): one line, the same under either name, naming Mmotor
+    rc, a, ea = run_cli("sweep", "gimbal_precession", "--x", "M_motor", "--x-range", "0", "1e-3", "--points", "2",
                         "--json")
-    assert rc == rc2 != 2 and a == b and json.loads(a)["x"]["name"] == "Mmotor"
+    rc2, b, eb = run_cli("sweep", "gimbal_precession", "--x", "Mmotor", "--x-range", "0", "1e-3", "--points", "2",
+                         "--json")
+    assert rc == rc2 == 1 and a == b == "" and ea == eb and "at any Mmotor of the sweep" in ea

@@ -294,3 +294,16 @@ def test_no_method_raises_at_a_double_root(method):
     rc, out, err = run_cli("frequencies", TOP, "--set", f"n={float(n)!r}", "--method", method, "--json")
     assert rc == 0 and "Traceback" not in err, err
     assert json.loads(out)["stability"]["class"] in ("boundary", "unknown")
+
+
+def test_a_subnormal_latitude_keeps_its_equilibrium():
+    """phi = 2.2e-308 deg (found by the ladder's property test): rows of the residual of
+    1e-323 beside terms of 1e-318 have no relative precision left; they are zero to double
+    precision's range (equilibrium.SUBNORMAL_FLOOR), and the set is answered by every rung."""
+    from gyro import ladder
+
+    model = load("torsion_gyrocompass")
+    p = model.vector(model.parameters({"phi": 2.2250738585072014e-308}))[None]
+    for method in ("default", "reference"):
+        s = ladder.spectrum(model, p, method)
+        assert np.all(np.isfinite(s.frequencies)), method

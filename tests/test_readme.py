@@ -90,6 +90,10 @@ def test_the_readme_has_console_sessions():
 @pytest.mark.parametrize("cmd, expected, code", CASES, ids=[c for c, _, _ in CASES])
 def test_readme_console_session(cmd, expected, code, tmp_path):
     run = cmd.replace(".venv/bin/", f"{BIN}/")
+    # the README's commands run from the checkout's root; here in a fresh folder, so that
+    # what they write lands there: the checkout's own files by their full paths
+    for rel in (" tests/models/", " examples/"):
+        run = run.replace(rel, f" {ROOT}/{rel.strip()}")
     env = dict(os.environ, GYRO_CACHE=os.environ.get("GYRO_CACHE", str(Path.home() / ".cache" / "gyro-dynamics")))
     proc = subprocess.run(run, shell=True, cwd=tmp_path, capture_output=True, text=True, env=env, timeout=600)
     got = proc.stdout + _screen(proc.stderr)

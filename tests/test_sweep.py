@@ -30,3 +30,25 @@ def test_sweep_cli_json_and_errors(capsys, tmp_path):
     assert main(["sweep", "torsion_gyrocompass", "--x", "m", "--x-range", "0.3", "0.5", "--points", "2",
                  "--out", str(tmp_path / "s.png")]) == 0
     assert "wrote" in capsys.readouterr().out and (tmp_path / "s.png").exists()
+
+
+def test_one_axis_grammar_for_sweeps_and_maps(tmp_path):
+    """sweep and stability-map take an axis as gyro map and level-map do, --x NAME=LO:HI[:N],
+    with the same output as --x NAME --x-range LO HI --points N (kept); both forms at once,
+    a range missing, and counts that disagree are refused in one line, exit 2."""
+    from tests.conftest import error_lines, run_cli
+
+    a = run_cli("sweep", "torsion_gyrocompass", "--x", "u=0:7.29e-5:3", "--json")
+    b = run_cli("sweep", "torsion_gyrocompass", "--x", "u", "--x-range", "0", "7.29e-5", "--points", "3", "--json")
+    assert a[0] == b[0] == 0 and a[1] == b[1]
+    a = run_cli("stability-map", "torsion_gyrocompass", "--x", "l2=-0.5:0.3:4", "--y", "H=0.01:10:4", "--y-log",
+                "--out", str(tmp_path / "a.png"), "--json")
+    b = run_cli("stability-map", "torsion_gyrocompass", "--x", "l2", "--x-range", "-0.5", "0.3", "--y", "H",
+                "--y-range", "0.01", "10", "--y-log", "--points", "4", "--out", str(tmp_path / "b.png"), "--json")
+    assert a[0] == b[0] == 0 and a[1] == b[1]
+    for args, word in ((["--x", "u=0:1e-4", "--x-range", "0", "1e-4"], "--x-range: the axis is given twice"),
+                       (["--x", "u"], "--x-range: required with --x NAME"),
+                       (["--x", "u=0:1e-4:3", "--points", "4"], "--points: the axes and --points give different"),
+                       (["--x", "u=0:x"], "--x u"), (["--x", "u=0:1e-4:2.5"], "N is not an integer")):
+        rc, out, err = run_cli("sweep", "torsion_gyrocompass", *args)
+        assert rc == 2 and out == "" and len(error_lines(err)) == 1 and word in err, (args, err)

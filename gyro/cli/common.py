@@ -93,6 +93,44 @@ def add_scheduler(p) -> None:
                         "an address (tcp://host:8786) uses a running scheduler (default: this process)")
 
 
+def axis(args, flag: str):
+    """One axis of a sweep or a map, in the grammar of `gyro map` and `gyro level-map`,
+    `--x NAME=LO:HI[:N]`, or as `--x NAME --x-range LO HI` (kept): (name, (lo, hi), N or
+    None). Either form, not both; ParameterError naming the flag otherwise."""
+    from gyro.errors import finite_number
+
+    text, rng = getattr(args, flag), getattr(args, f"{flag}_range")
+    if "=" not in text:
+        if rng is None:
+            raise ParameterError(f"--{flag}-range: required with --{flag} NAME (or give the axis as "
+                                 f"--{flag} NAME=LO:HI[:N])")
+        return text, tuple(rng), None
+    if rng is not None:
+        raise ParameterError(f"--{flag}-range: the axis is given twice (--{flag} {text} has its range)")
+    name, _, spec = text.partition("=")
+    parts = spec.split(":")
+    if not name.strip() or len(parts) not in (2, 3):
+        raise ParameterError(f"--{flag} {text!r}: expected NAME=LO:HI[:N]")
+    lo, hi = (finite_number(f"--{flag} {name.strip()}", v) for v in parts[:2])
+    n = None
+    if len(parts) == 3:
+        try:
+            n = int(parts[2])
+        except ValueError:
+            raise ParameterError(f"--{flag} {text!r}: N is not an integer: {parts[2]!r}") from None
+    return name.strip(), (lo, hi), n
+
+
+def axis_points(args, default: int, *ns) -> int:
+    """The points of an axis (or of both axes of a map): --points, or the N of the axes'
+    NAME=LO:HI:N, which must agree with each other and with --points where both are given."""
+    given = {n for n in ns if n is not None} | ({args.points} if args.points is not None else set())
+    if len(given) > 1:
+        raise ParameterError(f"--points: the axes and --points give different counts ({', '.join(map(str, sorted(given)))}); "
+                             "this command takes one")
+    return given.pop() if given else default
+
+
 def parse_sets(items: list[str]) -> dict[str, str]:
     """NAME=VALUE items into a dict (values still text: the model checks them)."""
     out = {}

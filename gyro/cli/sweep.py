@@ -1,13 +1,15 @@
-"""`gyro sweep MODEL --x NAME --x-range LO HI [--x-log] [--points N] [--method NAME]
-[--set NAME=VALUE]... [--json] [--out FILE.png]`: natural frequencies against one parameter."""
+"""`gyro sweep MODEL --x NAME=LO:HI[:N] [--x-log] [--points N] [--method NAME]
+[--set NAME=VALUE]... [--json] [--out FILE.png]`: natural frequencies against one parameter.
+The axis as `gyro map` takes one; `--x NAME --x-range LO HI` is kept as another way to say
+it."""
 from __future__ import annotations
 
 import json
 import math
 import sys
 
-from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_scheduler, add_set, check_png_out,
-                             model_with_equilibrium, parse_sets)
+from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_scheduler, add_set, axis,
+                             axis_points, check_png_out, model_with_equilibrium, parse_sets)
 from gyro.errors import ParameterError
 from gyro.methods import names as method_names
 
@@ -18,10 +20,12 @@ def register(sub) -> None:
     s = sub.add_parser("sweep", help="natural frequencies against one parameter")
     add_model(s)
     add_set(s)
-    s.add_argument("--x", required=True, metavar="NAME", help="the parameter swept")
-    s.add_argument("--x-range", nargs=2, type=float, required=True, metavar=("LO", "HI"))
+    s.add_argument("--x", required=True, metavar="NAME=LO:HI[:N]", help="the parameter swept and its range "
+                   "(or NAME with --x-range)")
+    s.add_argument("--x-range", nargs=2, type=float, default=None, metavar=("LO", "HI"),
+                   help="the range of --x NAME (the other form of the axis)")
     s.add_argument("--x-log", action="store_true", help="log-spaced (needs 0 < LO)")
-    add_points(s, 50, "values of the parameter (default: 50)")
+    add_points(s, None, "values of the parameter (default: 50, or the axis's N)")
     s.add_argument("--method", default="default", choices=method_names(), help="rung of the ladder (default: %(default)s)")
     add_json(s)
     add_out(s, required=False, help="also plot the frequencies into FILE.png")
@@ -37,6 +41,8 @@ def run(args) -> int:
 
     model = model_with_equilibrium(args.model)
     values = model.parameters(parse_sets(args.set))
+    args.x, args.x_range, n = axis(args, "x")
+    args.points = axis_points(args, 50, n)
     args.x = model.param_name(args.x, "--x")  # the declared name (another name taken for it too)
     lo, hi = args.x_range
     if not lo < hi or not (math.isfinite(lo) and math.isfinite(hi)):

@@ -229,3 +229,41 @@ def test_coulomb_friction_at_rest_has_no_operator_and_says_which_term(tmp_path):
     doc = json.loads(out)
     assert rc == 1 and doc["stability"] == ["stable", "failed", "stable"]
     assert abs(doc["frequencies"][2][0] - np.sqrt(44.0)) < 1e-13 * np.sqrt(44.0)  # k + k_s past the stop
+
+
+def test_coulomb_friction_equations_are_lagranges_methods():
+    """The block with Coulomb friction as SymPy's two methods give it (the issue: refused
+    outright before): LagrangesMethod with the friction as a force on its point, mass
+    matrix and forcing equal to ours, sign(x') included, at points on both sides of the
+    kink and on it."""
+    from sympy.physics.mechanics import LagrangesMethod, Lagrangian, Particle, Point, ReferenceFrame, dynamicsymbols
+
+    x = dynamicsymbols("x")
+    m, k, mu, g = sp.symbols("m k mu g", positive=True)
+    N = ReferenceFrame("N")
+    O = Point("O")
+    O.set_vel(N, 0)
+    P = O.locatenew("P", x * N.x)
+    P.set_vel(N, x.diff() * N.x)
+    block = Particle("block", P, m)
+    block.potential_energy = k * x**2 / 2
+    friction = [(P, -mu * m * g * sp.sign(x.diff()) * N.x)]
+    lm = LagrangesMethod(Lagrangian(N, block), [x], forcelist=friction, frame=N)
+    lm.form_lagranges_equations()
+    from derive.model import Model, Parameter
+
+    X, Xd, Xdd = sp.symbols("x x_d x_dd")
+    M_, K_, MU, G = sp.symbols("m k mu g")
+    model = Model(name="coulomb", title="Coulomb block", source="test", module=__name__,
+                  parameters=[Parameter("m", "kg", 1.0, "mass"), Parameter("k", "N/m", 4.0, "spring"),
+                              Parameter("mu", "1", 0.3, "friction", kind="nonnegative"),
+                              Parameter("g", "m/s^2", 9.81, "gravity")],
+                  coordinates=["x"], coordinate_units={"x": "m"}, q=[X], qd=[Xd], qdd=[Xdd],
+                  lagrangian=M_ * Xd**2 / 2 - K_ * X**2 / 2, generalized_forces={"x": -MU * M_ * G * sp.sign(Xd)})
+    d = pipeline.derive(model, pipeline.Steps(out=io.StringIO()))
+    theirs_M, theirs_f = _plain(lm.mass_matrix, [x]), _plain(lm.forcing, [x])
+    for xd in (sp.Rational(3, 10), sp.Rational(-3, 10), 0):
+        pt = {sp.Symbol("m"): 1, sp.Symbol("k"): 4, sp.Symbol("mu"): sp.Rational(3, 10), sp.Symbol("g"): sp.Rational(981, 100),
+              sp.Symbol("x"): sp.Rational(1, 10), sp.Symbol("x_d"): xd}
+        assert sp.simplify((d.mass_matrix - theirs_M).xreplace(pt)) == sp.zeros(1, 1)
+        assert sp.simplify((d.forcing - theirs_f).xreplace(pt)) == sp.zeros(1, 1), xd

@@ -68,10 +68,15 @@ def beside() -> bool:
 
 
 def _tie_to_parent(parent: int) -> None:
-    """A worker's initializer: killed when its parent dies (and at once if it already has)."""
+    """A worker's initializer: killed when its parent dies (and at once if it already has).
+    The wake-up pipes of the parent's pools, copied by the fork, are forgotten: at a
+    worker's exit concurrent.futures wakes every pool it knows, and writing to a copy the
+    parent has meanwhile closed printed "Exception ignored ... OSError: Bad file descriptor"
+    (2 runs in 6 where a model worker was killed beside one that went on)."""
     _prctl()(_PR_SET_PDEATHSIG, signal.SIGKILL)
     if os.getppid() != parent:
         os._exit(1)
+    getattr(cf.process, "_threads_wakeups", {}).clear()
 
 
 def _run(i: int):
@@ -103,10 +108,17 @@ def _stop(ex: cf.ProcessPoolExecutor) -> None:
     """The pool shut down with no worker left behind (one waiting on a pool that broke or
     never filled is killed)."""
     left = list((getattr(ex, "_processes", None) or {}).values())
+    manager = getattr(ex, "_executor_manager_thread", None)  # shutdown() forgets it
     ex.shutdown(wait=False, cancel_futures=True)
     for p in left:
         if p.is_alive():
             p.kill()
+    # the pool's manager thread closes its wake-up pipe as it ends: joined here, so that the
+    # interpreter's exit does not write to that pipe while the thread closes it (a race in
+    # concurrent.futures that printed "Exception ignored ... OSError: Bad file descriptor"
+    # after a model worker was killed)
+    if manager is not None and manager.is_alive():
+        manager.join(timeout=10)
 
 
 class later:

@@ -239,7 +239,8 @@ def count_ops(exprs) -> int:
                 return c + 1 + (1 if n < 0 else 0), (d,)
             if d is not sp.S.One:
                 return c + 1, ((d,) if not d.is_Integer else ()) + (n,)
-            return c + _generic(a)[0], _generic(a)[1]
+            extra, pushed = _generic(a)
+            return c + extra, pushed
         elif a.is_Add:
             c, pushed, negs = 0, [], 0
             for i, ai in enumerate(a.args):

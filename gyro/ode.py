@@ -19,6 +19,13 @@ from gyro.models import Model
 _CACHE: dict = {}
 
 
+class IntegrationBudget(RuntimeError):
+    """An integration stopped by its budget of time or steps (a runaway on stiff or extreme
+    input, a horizon too long for a level), saying how far it got: a numerical limit, exit 1
+    at the command line. The one type every integrator of the runtime raises (each analysis
+    names it too: gimbal, gyrohorizoncompass, precession, motion)."""
+
+
 @dataclass(frozen=True)
 class Symbolic:
     """y (2n), p (the parameters), inputs (the forcing's further inputs) as CasADi SX, and
@@ -173,7 +180,7 @@ def numpy_variational(model: Model, P, inputs=None):
 
 
 def budgeted(fun, label: str, t_end: float, max_s: float, max_steps: float, error=RuntimeError):
-    """fun(t, y) for solve_ivp that raises `error` (an analysis' IntegrationBudget) past
+    """fun(t, y) for solve_ivp that raises `error` (IntegrationBudget) past
     max_steps evaluations or max_s seconds from now, saying how far the run got."""
     import time
 

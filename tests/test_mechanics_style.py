@@ -21,7 +21,7 @@ import pytest
 import sympy as sp
 
 from derive import pipeline
-from tests.test_textbook import BACKENDS, MODELS, _finish, assert_close, call
+from tests.test_textbook import BACKENDS, MODELS, _finish, assert_close, call, check_symbolic
 
 def _derive(name):
     from derive.__main__ import build, load_file
@@ -313,11 +313,4 @@ def test_constrained_models_emit_and_compile(tmp_path):
         emit.emit(model, fns, pipeline.metadata(d), tmp_path / name)
         E = _finish(name, model, d, {f.name: f for f in fns}, tmp_path)
         for fname, fn in E.functions.items():
-            syms = [s for _, ss in fn.inputs for s in ss]
-            vals = {str(s): rng.uniform(0.5, 1.5) for s in syms}
-            with mpmath.workdps(30):
-                want = [np.array(sp.lambdify(syms, mat, modules="mpmath")(*[mpmath.mpf(vals[str(s)]) for s in syms])
-                                 .tolist(), dtype=float) for _, mat in fn.outputs]
-            for backend in BACKENDS:
-                for o, w in zip(call(E, fname, vals, backend), want):
-                    assert_close(o, w.reshape(o.shape), what=f"{backend} {name}.{fname}")
+            check_symbolic(E, fname, {str(s): rng.uniform(0.5, 1.5) for _, ss in fn.inputs for s in ss})

@@ -24,7 +24,7 @@ import sympy as sp
 
 from derive import pipeline
 from derive.model import Unsupported
-from tests.test_textbook import BACKENDS, MODELS, _finish, assert_close, call
+from tests.test_textbook import MODELS, _finish, check_symbolic
 
 
 def _load(name="top_body_speeds"):
@@ -108,14 +108,7 @@ def test_speeds_functions_through_every_backend(top, tmp_path):
     for _ in range(2):
         vals = defaults | {n: float(rng.uniform(-1.2, 1.2)) for n in ("q1", "q2", "q3", "u1", "u2", "u3")}
         for fname in ("kinematics", "speeds_mass_matrix", "speeds_forcing"):
-            fn = E.functions[fname]
-            syms = [s for _, ss in fn.inputs for s in ss]
-            with mpmath.workdps(30):
-                want = [np.array(sp.lambdify(syms, mat, modules="mpmath")(*[mpmath.mpf(vals[str(s)]) for s in syms])
-                                 .tolist(), dtype=float) for _, mat in fn.outputs]
-            for backend in BACKENDS:
-                for o, w in zip(call(E, fname, vals, backend), want):
-                    assert_close(o, w.reshape(o.shape), what=f"{backend} {fname}")
+            check_symbolic(E, fname, vals)
 
 
 def test_speeds_read_as_rates_are_refused_in_one_line():

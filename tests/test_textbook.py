@@ -177,6 +177,21 @@ def check_function(E: Emitted, fname: str, vals: dict, want: list, scales=None):
                          what=f"{backend} {E.name}.{fname}[{k}]")
 
 
+def symbolic_at(fn, vals: dict) -> list[np.ndarray]:
+    """A Function's symbolic outputs at `vals` (by symbol name), evaluated by mpmath at 30
+    digits: the answer every backend's outputs are held to."""
+    syms = [s for _, ss in fn.inputs for s in ss]
+    with mpmath.workdps(30):
+        return [np.array(sp.lambdify(syms, mat, modules="mpmath")(*[mpmath.mpf(vals[str(s)]) for s in syms]).tolist(),
+                         dtype=float) for _, mat in fn.outputs]
+
+
+def check_symbolic(E: Emitted, fname: str, vals: dict):
+    """Every backend's outputs of `fname` at `vals` against its symbolic outputs (symbolic_at)."""
+    check_function(E, fname, vals, [w.reshape(o.shape) for w, o in
+                                    zip(symbolic_at(E.functions[fname], vals), call(E, fname, vals, "numpy"))])
+
+
 def param_point(E: Emitted, rng, **fixed) -> dict:
     """Parameters at 0.5x..2x their defaults, some fixed by the caller."""
     vals = {p.name: p.default * rng.uniform(0.5, 2.0) for p in E.model.parameters}

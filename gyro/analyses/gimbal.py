@@ -42,6 +42,7 @@ from functools import cached_property
 import mpmath as mp
 import numpy as np
 
+from gyro import ode
 from gyro.models import ParameterError, load
 
 MODEL = "gimbal_gyroscope"
@@ -497,8 +498,7 @@ CASADI_METHODS = ("cvodes", "idas")
 METHODS = ("closed_form", *SCIPY_METHODS, *CASADI_METHODS)
 
 
-class IntegrationBudget(RuntimeError):
-    """An integrator stopped by its budget (a runaway on stiff or extreme input)."""
+IntegrationBudget = ode.IntegrationBudget  # the one type (gyro/ode.py)
 
 
 BUDGET_SECONDS = 25.0  # an integrator's wall time at the most (a command stays under 30 s)
@@ -520,8 +520,6 @@ def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, at
     if method in SCIPY_METHODS:
         from scipy.integrate import solve_ivp
 
-        from gyro import ode
-
         rhs = ode.budgeted(ode.numpy_rhs(load(MODEL), P), method, t[-1], budget_s, budget_steps, IntegrationBudget)
         sol = solve_ivp(rhs, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol)
         if not sol.success:
@@ -529,8 +527,6 @@ def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, at
         Y = sol.y.T
     elif method in CASADI_METHODS:
         import casadi as ca
-
-        from gyro import ode
 
         sym = ode.symbolic(load(MODEL))
         y, ydot = sym.y, ca.substitute(sym.ydot, sym.p, ca.DM(P))
@@ -653,6 +649,5 @@ def motion_answer(motion: Motion, t, method: str = "closed_form", rtol: float = 
         n = (t[-1] - t[0]) / cf.period if math.isfinite(cf.period) else math.inf
         est = eps * (16 * (1 + n) + 4 / math.sqrt(max(cf.m1, 1e-300)))
         return q, np.full(3, est * max(1.0, float(np.max(np.abs(q)))))
-    from gyro import ode
 
     return ode.two_tolerances(lambda r: integrate(motion, t, method, r, r * 1e-2, budget_s=BUDGET_SECONDS)[0], rtol)

@@ -34,7 +34,7 @@ from gyro.equilibrium import operators
 from gyro.errors import finite_number, grid_axis
 from gyro.kernels import function
 from gyro.models import ParameterError, load
-from gyro import qep
+from gyro import ode, qep
 from gyro.qep import companion_matrix
 from gyro.results import verdict
 
@@ -371,15 +371,12 @@ BUDGET_STEPS = 2 * 10**6  # and steps (right-hand sides for SciPy, steps per out
 CHUNK = 1000  # `projected`: fixed steps per compiled call
 
 
-class IntegrationBudget(RuntimeError):
-    """An integration stopped by its budget (a runaway on extreme input), saying how far it got."""
+IntegrationBudget = ode.IntegrationBudget  # the one type (gyro/ode.py)
 
 
 def _casadi_rhs():
     """y' = F(y, P), y = (q, q'), from the emitted CasADi mass matrix and forcing; and E(y, P)."""
     import casadi as ca
-
-    from gyro import ode
 
     s = ode.symbolic(model())
     y, p = s.y, s.p
@@ -427,8 +424,6 @@ def integrate(values: dict, y0: np.ndarray, t: np.ndarray, method: str = "DOP853
     if method in SCIPY_METHODS:
         from scipy.integrate import solve_ivp
 
-        from gyro import ode
-
         ca, y, p, ydot, _ = _casadi_rhs()
         f = ca.Function("f", [y, p], [ydot])
         jf = ca.Function("J", [y, p], [ca.jacobian(ydot, y)])
@@ -443,14 +438,14 @@ def integrate(values: dict, y0: np.ndarray, t: np.ndarray, method: str = "DOP853
         from gyro.ode import CASADI_QUIET, stderr_silenced
 
         ca, y, p, ydot, _ = _casadi_rhs()
-        ode = ca.substitute(ydot, p, ca.DM(P))
+        xdot = ca.substitute(ydot, p, ca.DM(P))
         # SUNDIALS counts steps between output times; no budget (a library call): SUNDIALS' own
         # ceiling (inf // k is NaN, and max(500, NaN) was 500 steps an interval)
         per = 10**9 if math.isinf(max_steps) else max(500, max_steps // max(1, len(t) - 1))
         opts = {"abstol": atol, "reltol": rtol, "max_num_steps": int(min(per, 10**9)), **CASADI_QUIET}
         if method == "cvodes-adams":  # non-stiff: Adams-Moulton with fixed-point iteration
             opts.update(linear_multistep_method="adams", nonlinear_solver_iteration="functional")
-        F = ca.integrator("F", "cvodes", {"x": y, "ode": ode}, t[0], t[1:], opts)
+        F = ca.integrator("F", "cvodes", {"x": y, "ode": xdot}, t[0], t[1:], opts)
         try:
             with stderr_silenced():  # SUNDIALS' error lines: the error below says it
                 Y = np.array(F(x0=y0)["xf"]).T
@@ -619,8 +614,6 @@ def first_correction(values: dict, ye: np.ndarray, A: np.ndarray, x: np.ndarray,
     linear motion grows, the correction would grow with its square)."""
     from scipy.integrate import solve_ivp
 
-    from gyro import ode
-
     t = np.asarray(t, float)
     xs = np.max(np.abs(x), axis=0)
     size = max(float(np.max(xs)), np.finfo(float).tiny)
@@ -677,7 +670,6 @@ def motion_answer(motion: Motion, t, method: str = LINEAR, rtol: float = RTOL):
         if not step <= limit:
             return q, np.full(4, np.inf)  # the linearisation fails: its error is not one small step
         return q, FIRST_STEP_FACTOR * step + rounding + U * np.max(np.abs(q), axis=0)
-    from gyro import ode
 
     y0 = ye + x0
     return ode.two_tolerances(lambda r: integrate(values, y0, t, method, r, r * 1e-2, budget_s=BUDGET_SECONDS,

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gyro import ode
 from gyro.errors import ParameterError
 
 METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")
@@ -21,8 +22,7 @@ BUDGET_S = 30.0
 BUDGET_EVALUATIONS = 5e6
 
 
-class IntegrationBudget(RuntimeError):
-    """The integration did not reach the end within its budget."""
+IntegrationBudget = ode.IntegrationBudget  # the one type (gyro/ode.py)
 
 
 @dataclass
@@ -99,8 +99,6 @@ def predicted_evaluations(model, P, y0, t_end: float) -> tuple[float, float]:
     prediction, not a bound: the budget still stops a run that needs more."""
     import casadi as ca
 
-    from gyro import ode
-
     s = ode.symbolic(model)
     zeros = [np.zeros(v.numel()) for v in s.inputs]
     with np.errstate(all="ignore"):
@@ -112,7 +110,6 @@ def predicted_evaluations(model, P, y0, t_end: float) -> tuple[float, float]:
 
 def _inputs(model):
     """inputs(t) for ode.numpy_rhs: the explicit time its value, every other input zero."""
-    from gyro import ode
 
     s = ode.symbolic(model)
     specs = model.meta["functions"]["forcing"]["inputs"][3:]
@@ -134,7 +131,6 @@ def simulate(model, values: dict, offsets: dict, t: np.ndarray, method: str = "D
              budget_s: float = BUDGET_S) -> "CoordinateMotion":
     from scipy.integrate import solve_ivp
 
-    from gyro import ode
     from gyro.results.trajectory import CoordinateMotion
 
     if method not in METHODS:

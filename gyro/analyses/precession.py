@@ -33,6 +33,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from gyro import ode
 from gyro.errors import ParameterError, finite_number
 from gyro.models import load
 
@@ -91,7 +92,6 @@ def _integrator(level: str, grid: tuple, steps: int, rtol_scale: float = 1.0, mu
     P = ca.SX.sym("P", npar + 1)  # parameters and the horizon T
     p, T = P[:npar], P[npar]
     if level == "full":
-        from gyro import ode
 
         s = ode.symbolic(load(MODEL))
         y = s.y
@@ -279,7 +279,6 @@ def _integrator_varying(level: str, grid: tuple, steps: int, rtol_scale: float, 
     tb, col = signals[0], signals[1]
     sig = ca.substitute(col, tb, t0 + T * s)
     if level == "full":
-        from gyro import ode
 
         so = ode.symbolic(load(MODEL), varying=True)
         y = so.y
@@ -328,9 +327,7 @@ def initial_state(level: str, values: dict, base=None) -> np.ndarray:
     return np.array([x0, y0, H0])
 
 
-class IntegrationBudget(RuntimeError):
-    """A level's integration stopped by its step budget away from the singularity (the
-    horizon is too long for it): a numerical limit, exit 1 at the command line."""
+IntegrationBudget = ode.IntegrationBudget  # the one type (gyro/ode.py)
 
 
 NEAR_SINGULAR_COS = 0.05  # |cos| of beta or alpha at the last state reached: on the way to +-90 deg

@@ -69,12 +69,13 @@ def _hints(cls) -> dict:
 def _rebuild(tp, value):
     """A field saved as JSON back in its declared type: a nested result (a dataclass, e.g.
     a sweep's Spectrum) field by field, an array from its list (complex from re/im)."""
+    import types
     import typing
 
     if value is None or tp is None:
         return value
     args = [a for a in typing.get_args(tp) if a is not type(None)]
-    if typing.get_origin(tp) in (typing.Union, getattr(__import__("types"), "UnionType", typing.Union)) and args:
+    if typing.get_origin(tp) in (typing.Union, types.UnionType) and args:  # X | None: X
         tp = args[0]
     if is_dataclass(tp) and isinstance(value, dict):
         hints = _hints(tp)

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from derive.models.gyrohorizoncompass import LAB
-from gyro.analyses import gyrohorizoncompass as ghc
+from gyro.systems import gyrohorizoncompass as ghc
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"

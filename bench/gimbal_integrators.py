@@ -19,7 +19,7 @@ from pathlib import Path
 import mpmath as mp
 import numpy as np
 
-from gyro.analyses.gimbal import ClosedForm, Motion, integrals, integrate, kick, stationary_motion
+from gyro.systems.gimbal_gyroscope import ClosedForm, Motion, integrals, integrate, kick, stationary_motion
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"

@@ -202,7 +202,7 @@ def torsion_motion_map(quick: bool) -> dict:
     rotor tilted by 1 mrad (gamma1) spin, K0, Kp, K_gamma 0.1x..10x and latitude 0..89 deg.
     Per point each coordinate's error, the linear level's bound and the integrator's own,
     and each level's seconds."""
-    from gyro.analyses import torsion_motion as tm
+    from gyro.systems import torsion_gyrocompass as tm
     from gyro.questions import motion
 
     lin, full = hierarchy.get(TG, "linear_motion"), hierarchy.get(TG, "nonlinear_motion")
@@ -212,7 +212,7 @@ def torsion_motion_map(quick: bool) -> dict:
         for a in np.geomspace(lo, hi, n + 2):
             cases.append((f"amplitude {key}", key, float(a), {}, float(a)))
     for key, amps in (("gamma_0", (0.2, 0.3, 0.45, 0.6)), ("beta_d0", (3.0, 10.0, 30.0))):
-        for a in amps:  # toward the cap of the linear bound (gyro.analyses.torsion_motion.CAP)
+        for a in amps:  # toward the cap of the linear bound (gyro.systems.torsion_gyrocompass.CAP)
             cases.append((f"near the cap {key}", key, a, {}, a))
     base = ("gamma1_0", 1e-3)
     for name in ("H", "K0", "Kp", "Kgamma"):
@@ -412,7 +412,7 @@ def ghc_motion_edge(quick: bool) -> list:
     set over 400 s at growing amplitudes, the largest first step over the angles against
     the linear motion's excursion (step/x) and the largest error over twice that step
     (beyond 1 the bound would be beaten)."""
-    import gyro.analyses.gyrohorizoncompass as ghc
+    import gyro.systems.gyrohorizoncompass as ghc
 
     m = load(GHC)
     out = []
@@ -655,7 +655,7 @@ class Sweep:
 
 def scene_sweeps(quick: bool) -> list:
     """The swept inputs of the scene figures, one per model with a hierarchy of levels."""
-    from gyro.analyses.gimbal import stationary_motion
+    from gyro.systems.gimbal_gyroscope import stationary_motion
 
     points = 25 if quick else 61
     P, s = spreads(points)["spin 0.1x..10x"]

@@ -88,7 +88,7 @@ def test_the_cycle_finder_finds_one():
 
 def test_the_flow_runs_one_way():
     g = import_graph()
-    layer = {"gyro.cli": 5, "gyro.analyses": 4, "gyro.questions": 4, "gyro.ladder": 3, "gyro.levels": 3, "gyro.methods": 2, "gyro.qep": 1,
+    layer = {"gyro.cli": 5, "gyro.analyses": 4, "gyro.systems": 4, "gyro.questions": 4, "gyro.ladder": 3, "gyro.levels": 3, "gyro.methods": 2, "gyro.qep": 1,
              "gyro.equilibrium": 1, "gyro.kernels": 1, "gyro.executor": 1, "gyro.ode": 1, "gyro.results": 1, "gyro.cbackend": 0, "gyro.models": 0}
 
     def level(m):
@@ -114,3 +114,14 @@ def test_the_runtime_never_imports_sympy_or_the_build_time_package():
                 names = [a.name for a in node.names] if isinstance(node, ast.Import) else [node.module or ""]
                 for n in names:
                     assert not n.startswith(("sympy", "symengine", "derive", "jinja2")), f"{path}: {n}"
+
+
+def test_the_wheel_lists_every_package():
+    """pyproject.toml lists the packages (the generated models map in from another folder, which
+    setuptools' finder cannot combine): every folder of gyro/ with an __init__.py is listed, and
+    nothing else but gyro.generated."""
+    import tomllib
+
+    listed = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
+    found = {".".join(p.parent.relative_to(ROOT).parts) for p in GYRO.rglob("__init__.py")}
+    assert listed - {"gyro.generated"} == found

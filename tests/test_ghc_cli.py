@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from gyro.analyses import gyrohorizoncompass as ghc
+from gyro.systems import gyrohorizoncompass as ghc
 from tests.conftest import run_cli
 
 LAB = {"A": 1.0, "B": 1.05, "C": 1.1, "J": 1.0, "L": 0.5, "I": 1.0, "nu": 1.0, "zeta": 0.5, "eta": 0.2}

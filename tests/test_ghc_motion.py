@@ -13,7 +13,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import gyro.analyses.gyrohorizoncompass as ghc
+import gyro.systems.gyrohorizoncompass as ghc
 from gyro import levels as hierarchy
 from gyro.analyses.scene import select
 from gyro.models import load

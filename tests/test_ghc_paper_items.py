@@ -188,7 +188,7 @@ def test_epsilon0_must_not_vanish():
 
 
 def _satellite(theta_, chi_, lam_, L_=2.0):
-    from gyro.analyses import gyrohorizoncompass as rt
+    from gyro.systems import gyrohorizoncompass as rt
 
     v = dict(A=2.0 - theta_, B=2.0 - chi_, C=2.0, J=1.0, L=L_, I=1.0, nu=1.0, zeta=1.0, eta=0.0, lam=lam_)
     return rt.stability(v, orbit=True), rt.analyse(rt.model().vector(v)[None], True)

@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from gyro import load
-from gyro.analyses.gimbal import (ClosedForm, Motion, U1_second, integrate, kick, mean_drift_paper, section6_case,
+from gyro.systems.gimbal_gyroscope import (ClosedForm, Motion, U1_second, integrate, kick, mean_drift_paper, section6_case,
                          stationary_motion, theta1_property_a, turning_motion, turning_points)
 
 DEFAULTS = load("gimbal_gyroscope").defaults  # the model's illustrative set

@@ -285,7 +285,7 @@ def test_models_are_found_without_a_list():
 
 
 def test_gimbal_quantities_are_emitted_and_agree_with_the_runtime():
-    from gyro.analyses import gimbal
+    from gyro.systems import gimbal_gyroscope as gimbal
     from gyro.models import load
 
     model = load("gimbal_gyroscope")

@@ -7,7 +7,7 @@ import json
 
 import pytest
 
-from gyro.analyses.precession import LEVELS
+from gyro.systems.gimbal_precession import LEVELS
 from tests.conftest import run_cli
 
 SIM_KEYS = {"model", "level", "params", "t", "x", "y", "alpha", "beta"}

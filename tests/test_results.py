@@ -10,7 +10,7 @@ import pytest
 
 from gyro import ladder, load
 from gyro.analyses import campbell
-from gyro.analyses.gimbal import Motion, trajectory
+from gyro.systems.gimbal_gyroscope import Motion, trajectory
 from gyro.analyses.stability_map import stability_grid
 from gyro.results import CampbellDiagram, ModalResult, Spectrum, StabilityMap, Trajectory
 

@@ -1,4 +1,4 @@
-"""The torsion gyrocompass's motion levels (docs/hierarchy.md, gyro.analyses.torsion_motion):
+"""The torsion gyrocompass's motion levels (docs/hierarchy.md, gyro.systems.torsion_gyrocompass):
 the linear motion is the exponential of the exact operator, its correction is its error
 against the integrated 11-coordinate equations, its bound holds at corners of the spreads
 and on held-out random sets, and the selector goes from the linear motion to the
@@ -13,7 +13,7 @@ from hypothesis import Phase, given, settings
 from hypothesis import strategies as st
 
 from gyro import levels as hierarchy
-from gyro.analyses import torsion_motion as tm
+from gyro.systems import torsion_gyrocompass as tm
 from gyro.analyses.scene import select
 from gyro.models import load
 from gyro.questions import motion as Q

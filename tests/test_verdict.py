@@ -11,7 +11,7 @@ import mpmath
 import numpy as np
 import pytest
 
-from gyro.analyses import gyrohorizoncompass as ghc
+from gyro.systems import gyrohorizoncompass as ghc
 from gyro.methods import reference
 from gyro.results import Spectrum, classify, verdict
 from tests.conftest import run_cli

@@ -169,17 +169,17 @@ def levels():
     """The hierarchy of the gimbal gyroscope (docs/hierarchy.md): the closed form (2.6)/(2.7)
     of section 2, exact for C0 = 0 (it refuses C0 != 0, and the selector goes on to the
     integrators), and the equations (1.1) integrated, any C0. Both bound the motion by the
-    evaluator's own estimate (gyro.analyses.gimbal.motion_answer). Costs: s per set at the
+    evaluator's own estimate (gyro.systems.gimbal_gyroscope.motion_answer). Costs: s per set at the
     default motion over a horizon of 1 s (bench/levels.py)."""
     from derive.model import Bound, Level
 
     return [
         Level("closed_form", "nothing of (1.1) at C0 = 0 (rounding only; it grows near the separatrix)",
-              {"kind": "trajectory", "analysis": "gimbal", "method": "closed_form"},
+              {"kind": "trajectory", "module": "gyro.systems.gimbal_gyroscope", "method": "closed_form"},
               {"motion": Bound(estimate=True)}, cost=8e-3, reference="integrated:DOP853",
               doc="theta by (2.6)/(2.7) through Weierstrass's wp, psi and phi by quadrature of (2.1), (2.3)"),
         Level("integrated", "nothing of (1.1) (the integrator's truncation: two tolerances compared)",
-              {"kind": "trajectory", "analysis": "gimbal", "methods": ["DOP853", "Radau"], "rtol": 1e-10,
+              {"kind": "trajectory", "module": "gyro.systems.gimbal_gyroscope", "methods": ["DOP853", "Radau"], "rtol": 1e-10,
                "default": "DOP853"},
               {"motion": Bound(estimate=True)}, cost={"DOP853": 0.6, "Radau": 4.0}, reference="closed_form",
               doc="the generated equations (1.1) integrated at rtol and rtol/100 (SciPy)"),

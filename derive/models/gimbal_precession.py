@@ -370,7 +370,7 @@ NEGLECTS = {
 
 def levels():
     """The five levels (docs/precession.md): each answers the motion of the image point over
-    a horizon, its bound the level's own estimate along its motion (gyro.analyses.precession:
+    a horizon, its bound the level's own estimate along its motion (gyro.systems.gimbal_precession:
     the neglected moments integrated, twice, and the integrator's), edges the singular
     casing angle."""
     from derive.model import Bound, Level
@@ -380,14 +380,14 @@ def levels():
     # the precession is the slow motion only while the base turns slowly against the nutation,
     # whose frequency is at least H |cos beta|/J (J every moment besides the rotor's momentum):
     # the runtime holds the same ratio along the motion with the frames' own rates added
-    # (gyro.analyses.precession.NUTATION_RATIO)
+    # (gyro.systems.gimbal_precession.NUTATION_RATIO)
     J = C1 + C2 + C3 + B1 + B2 + B3 + 2 * A1 + A3
     slow = {**valid, "|u| J/(H cos beta0) < 1/10 (the base slow against the nutation)":
             H * sp.Abs(sp.cos(beta0)) / 10 - sp.sqrt(u_xi**2 + u_eta**2 + u_zeta**2) * J}
     out = []
     for name in ("elementary", "small", "rigorous", "image", "full"):
         out.append(Level(name, NEGLECTS[name],
-                         {"kind": "trajectory", "analysis": "precession", "method": name, "quantities": ["x", "y"],
+                         {"kind": "trajectory", "module": "gyro.systems.gimbal_precession", "method": name, "quantities": ["x", "y"],
                           "scale": "excursion"},
                          {"motion": Bound(estimate=True)}, valid=valid if name == "full" else slow, cost=COSTS[name],
                          reference=None if name == "full" else "full",

@@ -357,12 +357,12 @@ def levels():
 
     return [
         Level("linear", "the terms of second and higher order in the perturbation of (3.1) in (1.5)-(1.6)",
-              {"kind": "trajectory", "analysis": "gyrohorizoncompass", "method": "linear", "rtol": 1e-6},
+              {"kind": "trajectory", "module": "gyro.systems.gyrohorizoncompass", "method": "linear", "rtol": 1e-6},
               {"motion": Bound(estimate=True)}, cost=0.4, reference="integrated:DOP853",
               doc="the linearised equations about (3.1) solved exactly (expm of the first-order matrix); "
                   "the estimate twice the first correction, integrated at rtol 1e-6"),
         Level("integrated", "nothing of (1.5)-(1.6) (the integrator's truncation: two tolerances compared)",
-              {"kind": "trajectory", "analysis": "gyrohorizoncompass", "methods": ["DOP853", "Radau"],
+              {"kind": "trajectory", "module": "gyro.systems.gyrohorizoncompass", "methods": ["DOP853", "Radau"],
                "rtol": 1e-10, "default": "DOP853"},
               {"motion": Bound(estimate=True)}, cost={"DOP853": 1.5, "Radau": 20.0}, reference="linear",
               doc="the emitted equations (1.5)-(1.6) integrated at rtol and rtol/100 (SciPy)"),

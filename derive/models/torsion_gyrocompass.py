@@ -598,17 +598,17 @@ def levels(F):
               {"kind": "harmonic_balance"}, {"forced": Bound(estimate=True)}, cost=4.2e-2,
               doc="the periodic response of the full 11-coordinate equations by harmonic balance, checked "
                   "against the shooting (docs/forced.md)"),
-        # the free motion about the equilibrium (gyro.analyses.torsion_motion); costs: median s per set
+        # the free motion about the equilibrium (gyro.systems.torsion_gyrocompass); costs: median s per set
         # over a horizon of 0.05 s (python -m bench.levels --torsion-motion)
         Level("linear_motion", "the full equations' terms of second and higher order in the perturbation",
-              {"kind": "trajectory", "analysis": "torsion_motion", "method": "linear", **motion},
+              {"kind": "trajectory", "module": "gyro.systems.torsion_gyrocompass", "method": "linear", **motion},
               {"motion": Bound(estimate=True)}, cost=0.4, reference="nonlinear_motion",
               doc="the exact operator's motion M x'' + D x' + K x = 0 by the exponential of its first-order "
                   "matrix, its error estimated by twice the correction of the full equations (the linear system "
                   "driven by their remainder, two Picard steps)"),
         Level("nonlinear_motion", "nothing of the 11-coordinate equations (the integrator's truncation: two "
               "tolerances compared)",
-              {"kind": "trajectory", "analysis": "torsion_motion", "method": "DOP853", "rtol": 1e-9, **motion},
+              {"kind": "trajectory", "module": "gyro.systems.torsion_gyrocompass", "method": "DOP853", "rtol": 1e-9, **motion},
               {"motion": Bound(estimate=True)}, cost=3.7,
               doc="the full 11-coordinate equations integrated (DOP853 at rtol 1e-9 and 1e-11, SciPy)"),
         # the double-precision methods take u2 = u cos(phi) rounded: cos(x) at x = phi pi/180 turns

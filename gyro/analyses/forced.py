@@ -210,7 +210,7 @@ class ReducedState:
     (10), gamma3's index k3, the equilibrium as all 11 coordinates q_ref; `state(x, xd)` the
     full state (q, q') of the reduced coordinates' displacements x and rates xd about it,
     gamma3's rate from the integral C r2 = H (the forced response's and the free motion's,
-    gyro.analyses.torsion_motion)."""
+    gyro.systems.torsion_gyrocompass)."""
 
     def __init__(self, model: Model, values: dict):
         from gyro.equilibrium import equilibrium

@@ -34,7 +34,7 @@ def register(sub) -> None:
 def run(args) -> int:
     if args.model not in MODELS:
         raise ParameterError(f"map: unknown model {args.model!r}; it covers {', '.join(MODELS)}")
-    from gyro.analyses.gyrohorizoncompass import cli_name, condition_map, parameters, parse_axis
+    from gyro.systems.gyrohorizoncompass import cli_name, condition_map, parameters, parse_axis
 
     xaxis, yaxis = parse_axis("--x", args.x), parse_axis("--y", args.y)
     if args.orbit and {xaxis[0], yaxis[0]} & {"zeta", "eta"}:

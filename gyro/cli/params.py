@@ -22,7 +22,7 @@ def run(args) -> int:
     if model.aliases:  # every command prints the name above and takes these for it too
         print("also taken: " + ", ".join(f"{a} for {n}" for a, n in model.aliases.items()))
     if model.name == "gimbal_gyroscope":  # a motion's initial conditions, for gyro simulate
-        from gyro.analyses.gimbal import INITIAL
+        from gyro.systems.gimbal_gyroscope import INITIAL
 
         print("initial conditions (gyro simulate; psi(0) = phi(0) = 0):")
         for name, (unit, default, description) in INITIAL.items():

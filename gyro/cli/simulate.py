@@ -69,7 +69,7 @@ def register(sub) -> None:
 
 
 def _initial_params() -> list:
-    from gyro.analyses.gimbal import INITIAL
+    from gyro.systems.gimbal_gyroscope import INITIAL
     from gyro.models import Param
 
     return [Param(n, u, d, desc, "real", (None, None)) for n, (u, d, desc) in INITIAL.items()]
@@ -77,7 +77,7 @@ def _initial_params() -> list:
 
 def parse(args):
     """(Motion, times, method) from the arguments, or ParameterError naming the input."""
-    from gyro.analyses.gimbal import METHODS, Motion
+    from gyro.systems.gimbal_gyroscope import METHODS, Motion
     from gyro.models import load
 
     if args.perturb is not None:
@@ -128,7 +128,7 @@ def _times(args):
 def _run_ghc(args) -> int:
     """gyrohorizoncompass: every input checked first (names, numbers, equilibrium, --perturb,
     --t-end, --points, --method, --out), then integrated."""
-    from gyro.analyses import gyrohorizoncompass as ghc
+    from gyro.systems import gyrohorizoncompass as ghc
 
     values = ghc.parameters(parse_sets(args.set))
     perturb = [0.0] * 4
@@ -159,7 +159,7 @@ def _run_ghc(args) -> int:
 def _run_precession(args) -> int:
     """gimbal_precession: every input checked first (names, numbers, --level, --t-end,
     --points, --out, the initial angles), then integrated by the level."""
-    from gyro.analyses import precession
+    from gyro.systems import gimbal_precession as precession
 
     for flag in ("perturb", "method"):
         if getattr(args, flag) is not None:
@@ -221,7 +221,7 @@ def _run_generic(args) -> int:
 
 def _oscillation(item: str):
     """One --base-rate NAME=AMP:FREQ[:PHASE] as an Oscillation, or ParameterError naming it."""
-    from gyro.analyses import precession
+    from gyro.systems import gimbal_precession as precession
 
     label = f"--base-rate {item!r}"
     name, sep, spec = item.partition("=")
@@ -234,7 +234,7 @@ def _oscillation(item: str):
 def run(args) -> int:
     import numpy as np
 
-    from gyro.analyses.gimbal import trajectory
+    from gyro.systems.gimbal_gyroscope import trajectory
 
     if args.model not in SIMULATED:
         return _run_generic(args)

@@ -31,7 +31,7 @@ def register(sub) -> None:
 def run(args) -> int:
     if args.model not in MODELS:
         raise ParameterError(f"stability: unknown model {args.model!r}; it covers {', '.join(MODELS)}")
-    from gyro.analyses.gyrohorizoncompass import parameters, stability
+    from gyro.systems.gyrohorizoncompass import parameters, stability
 
     values = parameters(parse_sets(args.set), orbit=args.orbit)
     res = stability(values, orbit=args.orbit)

@@ -2,8 +2,9 @@
 quantity per coordinate (in the model's order), its relative error the largest deviation
 over the horizon divided by the coordinate's largest magnitude (at least 1 rad) there.
 
-Evaluator kind: `trajectory`, {"analysis": MODULE, "method": NAME, "rtol": R}: the module
-gyro.analyses.MODULE offers INITIAL (name -> (unit, default, description): the initial
+Evaluator kind: `trajectory`, {"module": MODULE, "method": NAME, "rtol": R}: the module
+MODULE (a dotted name the model declares: gyro.systems.<system> for the papers' models,
+any importable module for a user's) offers INITIAL (name -> (unit, default, description): the initial
 conditions, which `gyro scene` takes with --set), `Motion(params, **initial)` and
 `motion_answer(motion, t, method, rtol) -> (q (times, coordinates), absolute error
 estimate per coordinate)`. An evaluator that refuses a set (the closed form with C0 != 0)
@@ -31,7 +32,14 @@ DEFAULT_HORIZON = 1.0  # s
 
 
 def _analysis(level):
-    return importlib.import_module(f"gyro.analyses.{level.evaluator['analysis']}")
+    """The module a motion level's evaluator declares (ParameterError where it cannot be imported)."""
+    from gyro.errors import ParameterError
+
+    name = level.evaluator["module"]
+    try:
+        return importlib.import_module(name)
+    except ImportError as exc:
+        raise ParameterError(f"level {level.name}: its evaluator's module {name!r} cannot be imported ({exc})") from None
 
 
 def initial_conditions(model) -> dict:

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gyro.systems import gimbal_precession as precession as pr
+from gyro.systems import gimbal_precession as pr
 from gyro.analyses.level_map import level_map
 from gyro.models import load
 

@@ -13,7 +13,7 @@ import pytest
 import sympy as sp
 
 from derive.models import gimbal_precession as gp
-from gyro.systems import gimbal_precession as precession as pr
+from gyro.systems import gimbal_precession as pr
 
 ROOT = Path(__file__).resolve().parent.parent
 BENCH = json.loads((ROOT / "bench" / "results" / "precession.json").read_text())

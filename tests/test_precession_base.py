@@ -12,7 +12,7 @@ import pytest
 import sympy as sp
 
 from derive.models import gimbal_precession as gp
-from gyro.systems import gimbal_precession as precession as pr
+from gyro.systems import gimbal_precession as pr
 from gyro.errors import ParameterError
 from tests.conftest import run_cli
 

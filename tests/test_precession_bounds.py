@@ -14,7 +14,7 @@ import numpy as np
 from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 
-from gyro.systems import gimbal_precession as precession as pr
+from gyro.systems import gimbal_precession as pr
 from gyro.analyses.scene import select
 from gyro.models import load
 

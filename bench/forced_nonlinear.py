@@ -3,14 +3,14 @@
 For one harmonic of the bearing imperfections, away from a resonance (f1, k = 1 at the
 example: omega_c = 2513 rad/s, 35 % below omega10) and near one (f3, k = 1 with H set so
 that omega_c is 1 % below the radial bearing mode omega_p = 780 rad/s), the periodic
-response of the full 11-coordinate equations (gyro.analyses.forced.nonlinear_response)
+response of the full 11-coordinate equations (gyro.systems.torsion_gyrocompass.nonlinear_response)
 against the linear one, on a ladder of amplitudes a, each twice the last at first and then
 closer about 1 %, each rung started from the last one's periodic motion (continuation in a):
 the first halving gives the order of the neglected terms, the smallest amplitude the
 constant c of err = c a^2, and the amplitude a_1% where they differ by 1 % is interpolated
 (log-log) between the two measured rungs about it; a ladder that does not cross 1 % says so
 and extrapolates from its top. Writes bench/results/forced_linear_limit.json:
-the first measured boundary of the linear level (gyro.analyses.forced.LINEAR_LIMIT,
+the first measured boundary of the linear level (gyro.systems.torsion_gyrocompass.LINEAR_LIMIT,
 docs/forced.md).
 """
 from __future__ import annotations
@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from gyro import load
-from gyro.analyses.forced import cases, harmonic_balance, linear_error, nonlinear_response, spin_torque
+from gyro.systems.torsion_gyrocompass import cases, harmonic_balance, linear_error, nonlinear_response, spin_torque
 
 RESULTS = Path(__file__).resolve().parent / "results"
 # the integration's tolerance and the shooting's periodicity: the error measured is then
@@ -110,7 +110,7 @@ def main() -> None:
             limit, how = float(amps[-1] * (0.01 / errs[-1]) ** (1 / p)), "extrapolated from the largest amplitude measured"
             bracket = None
         # at the limit itself: the error there (the interpolation's check) and what the
-        # left-out torque on the spin would change (gyro.analyses.forced.spin_torque)
+        # left-out torque on the spin would change (gyro.systems.torsion_gyrocompass.spin_torque)
         below = max((r for r in rows if r["a"] <= limit), key=lambda r: r["a"], default=None)
         Xn, Xl, info = nonlinear_response(model, case["values"], (case["harmonic"][0], case["harmonic"][1], limit,
                                                                   case["harmonic"][3]),

@@ -241,7 +241,10 @@ class Model:
     # the spin, for Campbell diagrams and harmonic lines (derive/outputs/spin.py):
     # {"parameter": name of the parameter that sets it, "rate": the spin rate in rad/s as an
     # expression of the parameters (default: the parameter itself), "whirl": [(a, b), ...]
-    # pairs of reduced coordinates whose orbit a -> b turns with the spin (forward whirl)}
+    # pairs of reduced coordinates whose orbit a -> b turns with the spin (forward whirl),
+    # "angle": optionally the coordinate that is the spin angle, cyclic or steady; its rate at
+    # the reference is the spin's, and the given functions of it are the harmonic inputs;
+    # "harmonics": (what those inputs are, their unit), for the output of `gyro forced`}
     spin: dict = field(default_factory=dict)
     # names a user types for parameters whose symbol the emitted code cannot carry (the
     # paper's lambda is `lam`, M_motor `Mmotor`): {name typed: parameter's name}; every

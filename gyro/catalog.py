@@ -26,6 +26,20 @@ def available() -> list[str]:
     return sorted(p.name for p in generated_dir().iterdir() if (p / "metadata.json").exists())
 
 
+@lru_cache(maxsize=None)
+def metadata(name: str) -> dict:
+    """A generated model's metadata.json, read once (json only: no NumPy)."""
+    import json
+
+    return json.loads((generated_dir() / name / "metadata.json").read_text())
+
+
+def declaring(predicate) -> list[str]:
+    """The generated models whose metadata satisfies `predicate`: the models a command that
+    needs a declaration (a spin angle, conditions) lists in its help."""
+    return [n for n in available() if predicate(metadata(n))]
+
+
 def module_constants(folder, wanted: tuple) -> dict:
     """module name -> {constant: value} of the top-level constants `wanted` (NAME, RUNG, ...)
     of every public module in `folder`, read from the sources without importing them:

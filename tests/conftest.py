@@ -28,7 +28,7 @@ TIERS = {
                 "test_equilibrium_c", "test_rightmodel"),
     "properties": ("test_properties",),
     "cli": ("test_cli", "test_gimbal_simulate", "test_readme", "test_sweep", "test_wheel", "test_ghc_cli", "test_fuzz", "test_robustness",
-            "test_tolerance", "test_executor", "test_motion_generic", "test_precession_cli", "test_forced",
+            "test_tolerance", "test_executor", "test_motion_generic", "test_forced_generic", "test_precession_cli", "test_forced",
             "test_unbalance_lagrangian", "test_campbell_stability", "test_param_names"),
 }
 _TIER_OF = {f: tier for tier, files in TIERS.items() for f in files}

@@ -211,7 +211,7 @@ def test_nonlinear_periodic_response_agrees_to_second_order(case, a):
     and the shooting's tolerances here (rtol 1e-10, periodic to 1e-7 of the state's scale,
     ten times the bench's, for fewer Newton steps) leave the error accurate to about 1e-3 of
     itself (the bench's 1e-8 gives 1e-4, against runs at 1e-12)."""
-    from gyro.analyses.forced import LINEAR_LIMIT, cases, linear_error, linear_limit, nonlinear_response
+    from gyro.systems.torsion_gyrocompass import LINEAR_LIMIT, cases, linear_error, linear_limit, nonlinear_response
 
     assert LINEAR_LIMIT[case] == {k: linear_limit()["cases"][case][k] for k in ("c", "order", "a_1percent")}
     units = [MODEL.meta["coordinate_units"][c] for c in MODEL.meta["reduced"]]
@@ -230,7 +230,7 @@ def test_the_measured_one_percent_limit_is_bracketed(case):
     resonance the error grows slowly there (0.98 % at 32 N, 1.05 % at 64 N: the torsion
     angle lambda, 1.1 % of the largest angle's linear amplitude, is lost to the nonlinear
     terms), so the two points decide by about 4 % of the error, against the shooting's 1e-3."""
-    from gyro.analyses.forced import LINEAR_LIMIT, cases, linear_error, linear_limit, nonlinear_response
+    from gyro.systems.torsion_gyrocompass import LINEAR_LIMIT, cases, linear_error, linear_limit, nonlinear_response
 
     bench = linear_limit()["cases"][case]
     assert bench["a_1percent_is"] == "interpolated between measured amplitudes"
@@ -259,7 +259,7 @@ def test_the_spin_torque_left_out_is_measured():
     h gamma2 f3', dU/dgamma3 of (1.10), by hand here for f1 alone."""
     import casadi as ca
 
-    from gyro.analyses.forced import cases, nonlinear_response, spin_torque
+    from gyro.systems.torsion_gyrocompass import cases, nonlinear_response, spin_torque
 
     values, (s, k, phi) = cases(MODEL)["away"]
     a = 400.0
@@ -305,7 +305,7 @@ def test_harmonic_balance_is_the_shooting_and_its_first_step_estimates_the_linea
     first Newton step from the linear response is the linear response's error to 1e-3 of
     itself (measured at most 3.6e-4 away, 4.7e-5 near, up to the 1 % limits): an estimate of
     the linear level's error without the later steps."""
-    from gyro.analyses.forced import cases, harmonic_balance, linear_error, nonlinear_response
+    from gyro.systems.torsion_gyrocompass import cases, harmonic_balance, linear_error, nonlinear_response
 
     units = [MODEL.meta["coordinate_units"][c] for c in MODEL.meta["reduced"]]
     values, (s, k, phi) = cases(MODEL)["near"]
@@ -326,7 +326,7 @@ def test_the_forced_question_takes_the_linear_level_while_its_estimate_allows():
     step stays within the tolerance, the nonlinear level (harmonic balance) above; its
     actual error against the nonlinear level is within the bound it gave, per coordinate,
     away from and near the radial resonance, up to and past the 1 % limits."""
-    from gyro.analyses.forced import cases
+    from gyro.systems.torsion_gyrocompass import cases
     from gyro.analyses.scene import level_error, select
 
     for case, amps in (("away", (100.0, 2400.0)), ("near", (4.0, 32.0))):

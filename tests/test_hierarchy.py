@@ -514,7 +514,7 @@ def test_the_linear_forced_levels_estimate_holds_the_solves_conditioning_near_re
     condition of J(i w): an error of 7e-12 was measured there against an estimate of 1e-15
     (its floor) at 1e-9 N; the estimate now carries 4 n eps kappa(J_s), which the example's
     spin, far from any resonance, keeps near its floor."""
-    from gyro.analyses import forced
+    from gyro.systems import torsion_gyrocompass as forced
     from gyro.questions.forced import solve_rounding
 
     def rounding(values):  # the linear response as harmonic_balance starts from it, per unit group

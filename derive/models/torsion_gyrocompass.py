@@ -591,11 +591,13 @@ def levels(F):
         Level("linear", "the full equations' terms of second and higher order in the amplitudes",
               # costs: medians over the bench's two ladders of amplitudes (bench/forced_nonlinear.py,
               # first_step_seconds and harmonic_balance.seconds in bench/results/forced_linear_limit.json)
-              {"kind": "harmonic"}, {"forced": Bound(estimate=True)}, cost=1.5e-2, reference="nonlinear",
+              {"kind": "harmonic", "module": "gyro.systems.torsion_gyrocompass"},
+              {"forced": Bound(estimate=True)}, cost=1.5e-2, reference="nonlinear",
               doc="the linear response J(i w) X = B u to one imperfection harmonic, its error estimated by "
                   "harmonic balance's first Newton step (docs/forced.md)"),
         Level("nonlinear", "harmonics of the forcing above the 15th in the periodic response",
-              {"kind": "harmonic_balance"}, {"forced": Bound(estimate=True)}, cost=4.2e-2,
+              {"kind": "harmonic_balance", "module": "gyro.systems.torsion_gyrocompass"},
+              {"forced": Bound(estimate=True)}, cost=4.2e-2,
               doc="the periodic response of the full 11-coordinate equations by harmonic balance, checked "
                   "against the shooting (docs/forced.md)"),
         # the free motion about the equilibrium (gyro.systems.torsion_gyrocompass); costs: median s per set
@@ -641,7 +643,9 @@ def build():
         given_derivatives=list(sp.symbols("dF1 dF2 dF3")),
         dissipation=bearing_dissipation(),
         cyclic={CYCLIC: H},
-        spin={"parameter": "H", "rate": H / C},  # (2.3)-(2.4): the spin rate omega_c = H/C
+        # (2.3)-(2.4): the spin rate omega_c = H/C; the spin angle gamma3, whose functions
+        # f_s(gamma3) (1.10) are the harmonic inputs `gyro forced` drives
+        spin={"parameter": "H", "rate": H / C, "angle": CYCLIC, "harmonics": ("bearing imperfections", "N")},
         reduced=REDUCED,
         symmetric_zero=ODD,
         equilibrium_approx=equilibrium_approx(),

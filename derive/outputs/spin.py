@@ -1,7 +1,11 @@
 """The spin a model declares (Model.spin): which parameter sets it, the spin rate in rad/s
 as an expression of the parameters (emitted as `spin_rate`, so that the runtime never
 retypes it: the torsion gyrocompass's omega_c = H/C of (2.4)), and the coordinate pairs
-whose orbit tells forward from backward whirl."""
+whose orbit tells forward from backward whirl. Optionally the spin angle ("angle": a
+coordinate whose rate at the reference is the spin's): the given functions of that angle
+are then the model's harmonic inputs (the torsion gyrocompass's bearing imperfections
+f_s(gamma3)), which `gyro forced` drives at multiples of the angle's rate; "harmonics":
+(what they are, their unit) names them in its output."""
 from __future__ import annotations
 
 import sympy as sp
@@ -16,9 +20,10 @@ def _declared(d):
     if not spin:
         return None
     model = d.model
-    unknown = set(spin) - {"parameter", "rate", "whirl"}
+    unknown = set(spin) - {"parameter", "rate", "whirl", "angle", "harmonics"}
     if unknown:
-        raise Unsupported(f"{model.name}: spin: unknown keys {sorted(unknown)}; known: parameter, rate, whirl")
+        raise Unsupported(f"{model.name}: spin: unknown keys {sorted(unknown)}; known: parameter, rate, whirl, angle, "
+                          "harmonics")
     name = spin.get("parameter")
     if name not in [p.name for p in model.parameters]:
         raise Unsupported(f"{model.name}: spin: parameter {name!r} is not a parameter of the model")
@@ -34,6 +39,24 @@ def _declared(d):
             raise Unsupported(f"{model.name}: spin: whirl pair {pr} is not two reduced coordinates "
                               f"({', '.join(d.order)})")
     return name, rate, pairs
+
+
+def _angle(d) -> tuple[str | None, list]:
+    """The declared spin angle (a coordinate) and the harmonic inputs: the given values whose
+    function's one argument is that angle, in the order of the model's inputs."""
+    model = d.model
+    angle = model.spin.get("angle")
+    if angle is None:
+        return None, []
+    angle = str(angle)
+    if angle not in model.coordinates:
+        raise Unsupported(f"{model.name}: spin: angle {angle!r} is not a coordinate ({', '.join(model.coordinates)})")
+    if angle not in model.cyclic and angle not in model.steady:
+        raise Unsupported(f"{model.name}: spin: angle {angle!r} turns at no declared rate: it must be cyclic "
+                          "(Model.cyclic, its momentum given) or steady (Model.steady, its rate given)")
+    qa = model.coordinate(angle)
+    harmonic = [str(v) for f, v in zip(model.given_functions, model.given_values) if tuple(f.args) == (qa,)]
+    return angle, harmonic
 
 
 def functions(d) -> list[Function]:
@@ -54,4 +77,9 @@ def metadata(d) -> dict:
     if spin is None:
         return {}
     name, rate, pairs = spin
-    return {"spin": {"parameter": name, "rate": str(rate), "whirl": [list(p) for p in pairs]}}
+    out = {"parameter": name, "rate": str(rate), "whirl": [list(p) for p in pairs]}
+    angle, harmonic = _angle(d)
+    if angle is not None:
+        label, unit = d.model.spin.get("harmonics", ("harmonics of the spin angle", ""))
+        out.update(angle=angle, harmonic_inputs=harmonic, harmonic_label=str(label), harmonic_unit=str(unit))
+    return {"spin": out}

@@ -3,9 +3,11 @@
 A model declares its spin (Model.spin: the parameter and the rate as an expression,
 emitted as `spin_rate`); without a declaration, a parameter in rad/s is the spin rate
 itself. One definition for the Campbell diagram, its harmonic lines and the unbalance
-response. The bearing imperfections of the torsion gyrocompass are functions of gamma3,
-whose rate at the relative equilibrium is (2.3) (`spin_rate`: the declared H/C less the
-Earth rate on the spin axis)."""
+response. A model that also declares its spin angle (Model.spin "angle") has harmonic
+inputs, the given functions of that angle, which turn at the angle's rate at the
+reference: the emitted `reference_state`'s rate of that coordinate (for the torsion
+gyrocompass gamma3' of (2.3), H/C less the Earth rate on the spin axis, from the integral
+C r2 = H)."""
 from __future__ import annotations
 
 import numpy as np
@@ -13,24 +15,38 @@ import numpy as np
 from gyro.kernels import function
 from gyro.models import Model, ParameterError
 
-MODELS = ("torsion_gyrocompass",)  # models whose spin rate is given by (2.3)
+
+def harmonic_inputs(model: Model) -> tuple[str, list[str]]:
+    """(the spin angle, its harmonic inputs) the model declares; ParameterError in one line
+    naming the declaration it lacks."""
+    spin = model.meta.get("spin", {})
+    if not spin.get("angle"):
+        raise ParameterError(f"{model.name} declares no spin angle (Model.spin 'angle': a cyclic or steady "
+                             "coordinate whose given functions are the harmonic inputs; docs/models.md)")
+    if not spin.get("harmonic_inputs"):
+        raise ParameterError(f"{model.name} declares the spin angle {spin['angle']} but no given function of it "
+                             "(the harmonic inputs; docs/models.md)")
+    return spin["angle"], list(spin["harmonic_inputs"])
 
 
 def spin_rate(model: Model, P: np.ndarray, qe: np.ndarray | None = None) -> np.ndarray:
-    """omega_c = gamma3' at the relative equilibrium, (2.3) at rest: H/C less the Earth rate
-    on the spin axis, u cos(phi) + u sin(phi) (beta0 + gamma20) (within u/omega_c = 3e-8
-    of H/C at the example; tests/test_paper_items.py)."""
-    if model.name not in MODELS:
-        raise ParameterError(f"{model.name}: no spin rate of the bearing imperfections (torsion gyrocompass only)")
-    P = np.atleast_2d(P)
-    col = {n: P[:, i] for i, n in enumerate(model.param_names)}
-    W = col["H"] / col["C"]
+    """The spin angle's rate (rad/s) of each set: at the reference (the emitted
+    `reference_state`) of the equilibria qe, or the declared spin rate where qe is None.
+    NaN where the set has no equilibrium (qe NaN)."""
+    angle, _ = harmonic_inputs(model)
+    P = np.atleast_2d(np.asarray(P, float))
     if qe is None:
-        return W
-    eq = model.meta["equilibrium_coordinates"]
-    phi = np.radians(col["phi"])
-    tilt = qe[:, eq.index("beta")] + qe[:, eq.index("gamma2")]
-    return W - col["u"] * np.cos(phi) - col["u"] * np.sin(phi) * tilt
+        with np.errstate(all="ignore"):
+            return np.asarray(function(model, "spin_rate")(P)[0], float).reshape(len(P))
+    args = [P]
+    if model.meta["equilibrium_coordinates"]:
+        args.append(np.atleast_2d(np.asarray(qe, float)))
+    if any(i["name"] == "time" for i in model.meta["functions"]["reference_state"]["inputs"]):
+        args.append(np.zeros((len(P), 1)))
+    with np.errstate(all="ignore"):
+        _, qd = function(model, "reference_state")(*args)
+    qd = np.asarray(qd, float).reshape(len(P), -1)
+    return qd[:, list(model.meta["coordinates"]).index(angle)]
 
 
 def spin_parameter(model: Model, name: str | None, sole_rate: bool = False) -> str:

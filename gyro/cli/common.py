@@ -31,11 +31,14 @@ class Parser(argparse.ArgumentParser):
         sys.exit(EXIT_USAGE)
 
 
-def add_model(p, models=None, help="the model (gyro params MODEL lists its parameters)") -> None:
-    """The positional MODEL, its choices the generated models (or `models`)."""
-    from gyro.catalog import available, model_source
+def add_model(p, models=None, help="the model (gyro params MODEL lists its parameters)", declares=None) -> None:
+    """The positional MODEL, its choices the generated models (or `models`). With `declares`
+    (a predicate on a model's metadata) the help lists the generated models that declare what
+    the command needs; any model is still taken, and one that lacks it is refused when run."""
+    from gyro.catalog import available, declaring, model_source
 
     known = list(models or available())
+    listed = declaring(declares) if declares is not None else known
 
     def model_name(text: str) -> str:
         if text in known:
@@ -52,7 +55,8 @@ def add_model(p, models=None, help="the model (gyro params MODEL lists its param
         raise argparse.ArgumentTypeError(f"unknown model {text!r}; known: {', '.join(known)}")
 
     more = ", or a model file PATH.py (derived on first use), or an emitted folder DIR/<name>" if models is None else ""
-    p.add_argument("model", type=model_name, metavar="MODEL", help=f"{help}; one of: {', '.join(known)}{more}")
+    p.add_argument("model", type=model_name, metavar="MODEL",
+                   help=f"{help}; one of: {', '.join(listed) or '(no generated model declares it)'}{more}")
 
 
 def add_set(p, help: str | None = SET_HELP) -> None:

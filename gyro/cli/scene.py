@@ -121,8 +121,9 @@ def run(args) -> int:
         if args.question != "forced":
             raise ParameterError(f"--harmonic: only for the forced question, not {args.question!r}")
         from gyro.analyses.forced import parse_harmonic
+        from gyro.analyses.spin import harmonic_inputs
 
-        opts["harmonic"] = parse_harmonic(args.harmonic)
+        opts["harmonic"] = parse_harmonic(args.harmonic, len(harmonic_inputs(model)[1]))
     elif args.question == "forced":
         raise ParameterError("--harmonic: the forced question needs one harmonic S:K:AMP[:PHASE]")
     if args.question == "motion":

@@ -73,6 +73,22 @@ def get(name: str):
     return importlib.import_module(f"{__name__}.{_declared()[name]}")
 
 
+def evaluator_module(level):
+    """The module a level's evaluator declares ("module": a dotted name; gyro.systems.<system>
+    for the papers' models, any importable module for a user's); ParameterError in one line
+    where it is missing or cannot be imported."""
+    from gyro.errors import ParameterError
+
+    name = level.evaluator.get("module")
+    if not name:
+        raise ParameterError(f"level {level.name}: its evaluator of kind {level.evaluator.get('kind')!r} names no "
+                             "module (\"module\": a dotted name)")
+    try:
+        return importlib.import_module(name)
+    except ImportError as exc:
+        raise ParameterError(f"level {level.name}: its evaluator's module {name!r} cannot be imported ({exc})") from None
+
+
 def unknown_kind(question: str, level) -> ValueError:
     return ValueError(f"level {level.name}: the question {question!r} has no evaluator of kind "
                       f"{level.evaluator.get('kind')!r}")

@@ -3,10 +3,12 @@ imperfections, f_s = a sin(k omega_c t + phi) (`--harmonic S:K:AMP[:PHASE]`, as 
 forced` takes it); one quantity per reduced coordinate (the model's order), its complex
 amplitude X (x = Re(X e^{i k omega_c t}) about the equilibrium). The relative error of a
 quantity is |X - X_ref| over the largest linear amplitude of its unit group (translations,
-angles), the metric of `gyro.analyses.forced.linear_error` per coordinate: a coordinate whose
+angles), the metric of the module's `linear_error` per coordinate: a coordinate whose
 response is a millionth of its group's is not asked for six digits of its own.
 
-Evaluator kinds (gyro.analyses.forced):
+Evaluator kinds, each with "module": the module whose `harmonic_balance(model, values,
+harmonic, first_step_only=...)` -> (X, X_linear, info) the level uses (for the torsion
+gyrocompass gyro.systems.torsion_gyrocompass):
 - `harmonic`: the linear response J(i w) X = B u; its own estimate is twice the largest first
   Newton step of harmonic balance from it over the coordinate's unit group (measured: that
   step is the linear response's error to 3.6e-4 of itself up to the 1 % limits,
@@ -25,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from gyro.errors import ParameterError
-from gyro.questions import Answer, unknown_kind
+from gyro.questions import Answer, evaluator_module, unknown_kind
 
 NAME = "forced"
 VALUES = "amplitudes"  # the JSON key of the per-quantity answer (the scene table shows it)
@@ -50,11 +52,10 @@ def harmonic(opts):
 
 
 def answer(model, level, P, opts) -> Answer:
-    from gyro.analyses import forced
-
     kind = level.evaluator.get("kind")
     if kind not in ("harmonic", "harmonic_balance"):
         raise unknown_kind(NAME, level)
+    forced = evaluator_module(level)  # its harmonic_balance (the torsion gyrocompass's own)
     s, k, a, phi = harmonic(opts)
     N, n = P.shape[0], len(quantities(model, opts))
     X = np.full((N, n), np.nan, complex)

@@ -20,11 +20,9 @@ near the origin is the answer, so its size is the scale.
 """
 from __future__ import annotations
 
-import importlib
-
 import numpy as np
 
-from gyro.questions import Answer, unknown_kind
+from gyro.questions import Answer, evaluator_module, unknown_kind
 
 NAME = "motion"
 POINTS = 201  # sample times over the horizon
@@ -32,14 +30,7 @@ DEFAULT_HORIZON = 1.0  # s
 
 
 def _analysis(level):
-    """The module a motion level's evaluator declares (ParameterError where it cannot be imported)."""
-    from gyro.errors import ParameterError
-
-    name = level.evaluator["module"]
-    try:
-        return importlib.import_module(name)
-    except ImportError as exc:
-        raise ParameterError(f"level {level.name}: its evaluator's module {name!r} cannot be imported ({exc})") from None
+    return evaluator_module(level)
 
 
 def initial_conditions(model) -> dict:

@@ -24,10 +24,12 @@ class _Amplitudes:
 
     @property
     def phases(self) -> np.ndarray:
-        """In (-pi, pi]: arg X (cosine form) plus PHASE_SHIFT; NaN where |X| is not finite."""
+        """In (-pi, pi]: arg X (cosine form) plus PHASE_SHIFT; NaN where |X| is not finite, or
+        exactly zero (a coordinate the input does not reach has no phase: printed '-', null
+        in JSON)."""
         with np.errstate(invalid="ignore"):
             a = np.angle(self.X) + self.PHASE_SHIFT
-            return np.where(np.isfinite(self.X), np.pi - np.mod(np.pi - a, 2 * np.pi), np.nan)
+            return np.where(np.isfinite(self.X) & (self.X != 0), np.pi - np.mod(np.pi - a, 2 * np.pi), np.nan)
 
 
 @dataclass
@@ -126,15 +128,17 @@ class ForcedResponse(_Amplitudes, Result):
     param_names: list
     params: np.ndarray  # (sets, n_params)
     spin_rate: np.ndarray  # (sets,) omega_c, rad/s
-    s: np.ndarray  # (harmonics,) index of f_s, 1..3
+    s: np.ndarray  # (harmonics,) index of f_s, 1..n (the model's harmonic inputs)
     k: np.ndarray  # (harmonics,) order
-    amplitude: np.ndarray  # (harmonics,) a, N
+    amplitude: np.ndarray  # (harmonics,) a, in input_unit
     phase: np.ndarray  # (harmonics,) phi, rad
     X: np.ndarray  # (sets, harmonics, n_q) complex, x(t) = Re(X e^{i k omega_c t})
     resonance: np.ndarray  # (sets, harmonics) bool
     natural: np.ndarray  # (sets, modes) natural frequencies, rad/s
     natural_error: np.ndarray  # (sets, modes) their relative error estimates
     equilibrium: np.ndarray  # (sets, equilibrium coordinates)
+    label: str = "bearing imperfections"  # what the harmonic inputs are (Model.spin "harmonics")
+    input_unit: str = "N"  # their unit
     PHASE_SHIFT = np.pi / 2  # phases of the sine form, as the forcing (1.11) is written
 
     @property
@@ -190,11 +194,12 @@ class ForcedResponse(_Amplitudes, Result):
 
     def table(self, k: int = 0) -> str:
         d = self.to_dict(k)
-        lines = [f"{self.title} ({self.model}): steady response to bearing imperfections",
+        lines = [f"{self.title} ({self.model}): steady response to {self.label}",
                  f"spin rate omega_c = {d['spin_rate']:.8g} rad/s; x = amplitude sin(k omega_c t + phase) "
                  "about the equilibrium"]
         for h in d["harmonics"]:
-            head = (f"f{h['s']}: a = {h['amplitude']:.6g} N, k = {h['k']}, phase {h['phase']:.6g} rad, "
+            unit = f" {self.input_unit}" if self.input_unit else ""
+            head = (f"f{h['s']}: a = {h['amplitude']:.6g}{unit}, k = {h['k']}, phase {h['phase']:.6g} rad, "
                     f"frequency {h['frequency']:.8g} rad/s; nearest natural frequency omega{h['nearest_mode']} = "
                     f"{h['nearest_natural_frequency']:.8g} rad/s")
             if h["resonance"]:
@@ -237,7 +242,7 @@ class ForcedResponse(_Amplitudes, Result):
             ax.legend(fontsize=7, ncol=3)
         axes[1].set_xlim(0, wmax)
         axes[1].set_xlabel("frequency k omega_c [rad/s] (dotted: natural frequencies; red: resonance)")
-        axes[0].set_title(f"Amplitude spectrum of the bearing-imperfection response: {self.title}", fontsize=10)
+        axes[0].set_title(f"Amplitude spectrum of the response to {self.label}: {self.title}", fontsize=10)
         save_figure(fig, out)
         plt.close(fig)
 

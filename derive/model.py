@@ -177,6 +177,36 @@ class Level:
     doc: str = ""
 
 
+def runtime_module(model, name: str) -> str:
+    """How the runtime finds a module a model declares (a simulate hook, a level's evaluator):
+    a dotted name it can import where the module lies outside the model's own folder (the
+    package's gyro.systems.<system>), else "file:" and the module's path: the model file
+    itself (`__name__`) or a Python file beside it, which the runtime cannot import by the
+    name the derivation used."""
+    import importlib.util
+    import sys
+    from pathlib import Path
+
+    own = sys.modules.get(model.module)
+    folder = Path(own.__file__).resolve().parent if own is not None and getattr(own, "__file__", None) else None
+    spec = None
+    if name in sys.modules and getattr(sys.modules[name], "__file__", None):
+        origin = sys.modules[name].__file__
+    else:
+        try:
+            spec = importlib.util.find_spec(name)
+        except (ImportError, ValueError):
+            spec = None
+        if spec is None or not spec.origin:
+            raise Unsupported(f"{model.name}: the declared module {name!r} cannot be found")
+        origin = spec.origin
+    origin = Path(origin).resolve()
+    if name == model.module or (folder is not None and folder in origin.parents and
+                                not (Path(__file__).resolve().parents[1] / "gyro") in origin.parents):
+        return f"file:{origin}"
+    return name
+
+
 @dataclass
 class Model:
     """A mechanical system as data: what the generic pipeline needs to derive and emit it."""
@@ -246,6 +276,14 @@ class Model:
     # the reference is the spin's, and the given functions of it are the harmonic inputs;
     # "harmonics": (what those inputs are, their unit), for the output of `gyro forced`}
     spin: dict = field(default_factory=dict)
+    # a motion of the model's own for `gyro simulate` (the gimbal gyroscope's closed form, the
+    # precession levels), in place of the generic integration from the reference:
+    # {"module": a dotted module name offering simulate_command(model, args, cli) -> a result
+    # with plot/to_dict/table, "options": the flags it takes among perturb, method, level,
+    # base_rate, "usage": one line `gyro params` prints; "initial": where the module's INITIAL
+    # (name -> (unit, default, description)) are taken as --set NAME=VALUE, a note on the
+    # coordinates they leave out ("psi(0) = phi(0) = 0"), which `gyro params` prints with them}
+    simulate: dict = field(default_factory=dict)
     # names a user types for parameters whose symbol the emitted code cannot carry (the
     # paper's lambda is `lam`, M_motor `Mmotor`): {name typed: parameter's name}; every
     # command and the API take either (gyro.models.Model.parameters)

@@ -20,7 +20,7 @@ from derive import constraints, convert
 from derive import mechanics as mech
 from derive import names, nonsmooth, parallel
 from derive.derivation import Derivation, VariantResult  # noqa: F401  (pipeline.Derivation, as before)
-from derive.model import TIME, Function, Load, Model, Unsupported
+from derive.model import TIME, Function, Load, Model, Unsupported, runtime_module
 
 P_SYMBOL = sp.Symbol("p")  # the operator d/dt
 Z_SYMBOL = sp.Symbol("z")  # p^2
@@ -527,6 +527,29 @@ def metadata(d: Derivation) -> dict:
         if unknown:
             raise Unsupported(f"aliases name no parameter: {', '.join(unknown)}")
         meta["aliases"] = dict(model.aliases)
+    if model.simulate:
+        meta["simulate"] = simulate_declaration(model)
     for kind in outputs.kinds():
         meta.update(getattr(kind, "metadata", lambda _: {})(d))
     return meta
+
+
+SIMULATE_KEYS = {"module", "options", "usage", "initial"}
+SIMULATE_OPTIONS = ("perturb", "method", "level", "base_rate")
+
+
+def simulate_declaration(model) -> dict:
+    """Model.simulate checked: a dotted module name, options among SIMULATE_OPTIONS."""
+    decl = dict(model.simulate)
+    unknown = sorted(set(decl) - SIMULATE_KEYS)
+    if unknown:
+        raise Unsupported(f"simulate: unknown keys {unknown}; known: {', '.join(sorted(SIMULATE_KEYS))}")
+    module = decl.get("module")
+    if not isinstance(module, str) or not all(part.isidentifier() for part in module.split(".")):
+        raise Unsupported(f"simulate: 'module' must be a dotted module name, got {module!r}")
+    options = list(decl.get("options", []))
+    bad = [o for o in options if o not in SIMULATE_OPTIONS]
+    if bad:
+        raise Unsupported(f"simulate: unknown options {bad}; known: {', '.join(SIMULATE_OPTIONS)}")
+    return {"module": runtime_module(model, module), "options": options, "usage": str(decl.get("usage", "")),
+            "initial": str(decl.get("initial", ""))}

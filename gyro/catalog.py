@@ -40,6 +40,35 @@ def declaring(predicate) -> list[str]:
     return [n for n in available() if predicate(metadata(n))]
 
 
+def declared_module(spec: str, what: str):
+    """The module a model declares for the runtime (derive.model.runtime_module): a dotted
+    name imported as such, or "file:PATH", a model file or a file beside it, loaded from its
+    path once. ParameterError in one line (naming `what`) where it cannot be loaded."""
+    import importlib
+    import importlib.util
+    import sys
+
+    try:
+        if not spec.startswith("file:"):
+            return importlib.import_module(spec)
+        path = Path(spec[5:])
+        key = f"_gyro_declared_{abs(hash(str(path))):x}"
+        if key not in sys.modules:
+            found = importlib.util.spec_from_file_location(key, path)
+            if found is None or not path.is_file():
+                raise ImportError(f"no file {path}")
+            module = importlib.util.module_from_spec(found)
+            sys.path.insert(0, str(path.parent))  # the file may import its neighbours
+            try:
+                found.loader.exec_module(module)
+            finally:
+                sys.path.remove(str(path.parent))
+            sys.modules[key] = module
+        return sys.modules[key]
+    except ImportError as exc:
+        raise ParameterError(f"{what}: the declared module {spec!r} cannot be imported ({exc})") from None
+
+
 def module_constants(folder, wanted: tuple) -> dict:
     """module name -> {constant: value} of the top-level constants `wanted` (NAME, RUNG, ...)
     of every public module in `folder`, read from the sources without importing them:

@@ -73,7 +73,7 @@ def test_a_time_dependent_model_takes_its_time():
     (["--perturb", "x"], "--perturb 'x': expected NAME=VALUE"),
     (["--perturb", "x=inf"], "--perturb x"),
     (["--method", "Euler"], "--method: unknown method 'Euler'"),
-    (["--level", "full"], "--level: only for gimbal_precession"),
+    (["--level", "full"], "--level: not for damped_oscillator (a generic motion from the reference"),
     # 5 rad/s for 1e9 s: about 4e11 evaluations, refused before the start, naming the cost
     (["--t-end", "1e9"], "would need about 3.8e+11 evaluations of the equations, over its budget of 5e+06"),
 ])
@@ -85,3 +85,27 @@ def test_bad_input_is_one_line_exit_2(args, match):
 def test_a_reference_of_given_momenta_is_refused_in_one_line():
     rc, out, err = run_cli("simulate", str(MODELS / "symmetric_top_euler.py"), "--t-end", "1")
     assert rc == 2 and out == "" and "stationary motion of given momenta (Lz, H)" in err
+
+
+OWN = str(MODELS / "oscillator_own_motion.py")
+
+
+def test_a_model_file_reaches_its_own_motion_through_its_declaration():
+    """Model.simulate names a module outside the package: `gyro simulate` answers by its
+    closed form, with its initial conditions as --set; `gyro params` lists them and the usage
+    line; a flag its motion does not take is one line naming what it takes."""
+    rc, out, err = run_cli("simulate", OWN, "--set", "x0=0.2", "--set", "v0=1", "--set", "k=8", "--t-end", "2",
+                           "--points", "9", "--json")
+    assert rc == 0, err
+    doc = json.loads(out)
+    t, w = np.array(doc["t"]), 2.0  # sqrt(8/2)
+    assert doc["method"] == "closed_form" and doc["params"]["k"] == 8.0
+    assert np.max(np.abs(np.array(doc["x"]) - (0.2 * np.cos(w * t) + 0.5 * np.sin(w * t)))) < 1e-15
+    rc, out, _ = run_cli("params", OWN)
+    assert rc == 0
+    assert "initial conditions (gyro simulate; the closed form's start):" in out and out.count("x' at t = 0") == 1
+    assert out.rstrip().endswith(f"gyro simulate oscillator_own_motion: --set x0 v0; --method closed_form (the only one)")
+    rc, out, err = run_cli("simulate", OWN, "--t-end", "1", "--perturb", "x=0.1")
+    assert rc == 2 and out == ""
+    (line,) = error_lines(err)
+    assert "--perturb: not for oscillator_own_motion; its motion takes --method (--set x0 v0;" in line

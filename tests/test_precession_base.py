@@ -242,7 +242,7 @@ def test_simulate_bad_base_rate_exits_2_in_one_line_and_writes_nothing(tmp_path,
 
 def test_base_rate_only_for_the_precession_model():
     rc, _, err = run_cli("simulate", "gimbal_gyroscope", "--t-end", "1", "--base-rate", "eta=1e-3:1")
-    assert rc == 2 and "--base-rate: only for gimbal_precession" in err
+    assert rc == 2 and "--base-rate: not for gimbal_gyroscope; its motion takes --method" in err
 
 
 def test_a_motion_to_beta_90_deg_on_a_turning_base_is_refused_where_it_gets_there():

@@ -67,7 +67,7 @@ def test_simulate_level_required_and_only_for_this_model():
     rc, _, err = run_cli("simulate", "gimbal_precession", "--t-end", "1")
     assert rc == 2 and "--level: required" in err
     rc, _, err = run_cli("simulate", "gimbal_gyroscope", "--t-end", "1", "--level", "full")
-    assert rc == 2 and "--level: only for gimbal_precession" in err
+    assert rc == 2 and "--level: not for gimbal_gyroscope; its motion takes --method" in err
 
 
 def test_level_map_contract(tmp_path):

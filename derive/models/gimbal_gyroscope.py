@@ -198,5 +198,9 @@ def build():
         reduced=["theta"],
         identities={"first integrals (1.2): H, L and the energy are conserved": integrals_are_conserved},
         quantities=quantities(),
+        simulate={"module": "gyro.systems.gimbal_gyroscope", "options": ["method"],
+                  "initial": "psi(0) = phi(0) = 0",
+                  "usage": "--set theta0 dtheta0 dpsi0 dphi0 (psi(0) = phi(0) = 0); --method closed_form (default), "
+                           "RK45, DOP853, Radau, BDF, LSODA, cvodes, idas"},
         levels=levels(),
     )

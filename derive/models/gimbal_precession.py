@@ -409,6 +409,9 @@ def build():
         steady={"phi": H / A3},
         identities={"kinematics (3)-(5) are the frames' angular velocities": kinematics_are_the_papers},
         quantities=quantities(),
+        simulate={"module": "gyro.systems.gimbal_precession", "options": ["level", "base_rate"],
+                  "usage": "--level full, rigorous, image, small or elementary (required); --base-rate "
+                           "NAME=AMP:FREQ[:PHASE] (NAME xi, eta or zeta)"},
         levels=levels(),
         aliases=CLI_NAMES,
         signals=BASE_RATE,

@@ -388,6 +388,10 @@ def build():
             "the integral E (2.2)-(2.3): its derivative is (1.5).omega2 + (1.6) epsilon'": energy_is_conserved,
         },
         quantities=quantities(),
+        simulate={"module": "gyro.systems.gyrohorizoncompass", "options": ["perturb", "method"],
+                  "usage": "--perturb D1,D2,D3,D4 or alpha=.. beta=.. gamma=.. epsilon=.. (rad, at rest, from the "
+                           "relative equilibrium (3.1)); --method DOP853 (default), RK45, Radau, BDF, LSODA, cvodes, "
+                           "cvodes-adams, projected (onto E = E(0))"},
         levels=levels(),
         aliases=CLI_NAMES,
         # the start of the runtime's Newton: (3.1) itself (from zero it found the other

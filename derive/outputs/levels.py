@@ -8,7 +8,7 @@ import json
 
 import sympy as sp
 
-from derive.model import Bound, Function, Unsupported
+from derive.model import Bound, Function, Unsupported, runtime_module
 
 ORDER = 45
 
@@ -51,7 +51,10 @@ def _layout(model):
         for vname, expr in lv.valid.items():
             valid.append({"name": vname, "row": len(margins)})
             margins.append(sp.sympify(expr))
-        levels.append({"name": lv.name, "neglects": lv.neglects, "evaluator": lv.evaluator,
+        evaluator = dict(lv.evaluator)
+        if "module" in evaluator:
+            evaluator["module"] = runtime_module(model, evaluator["module"])
+        levels.append({"name": lv.name, "neglects": lv.neglects, "evaluator": evaluator,
                        "answers": answers, "valid": valid, "cost": lv.cost,
                        "reference": lv.reference, "doc": lv.doc})
     return levels, bounds, margins

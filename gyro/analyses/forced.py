@@ -2,8 +2,8 @@
 
 A model that declares its spin angle (Model.spin "angle", a cyclic or steady coordinate)
 has harmonic inputs: the given functions of that angle, f_s(angle), s = 1..n in the order
-of its inputs (the torsion gyrocompass's bearing imperfections (1.10)-(1.11), forces along
-x1, x2, x3 and the moments h f1 on gamma1, -h f3 on gamma2, with gamma3 = omega_c t). Each
+of its inputs (paper 003's bearing imperfections (1.10)-(1.11), forces along x1, x2, x3 and
+the moments h f1 on gamma1, -h f3 on gamma2, with gamma3 = omega_c t). Each
 harmonic f_s = a sin(k angle + phi), the angle turning at its rate at the reference
 omega_c (gyro.analyses.spin.spin_rate), is the input u_s = -i a e^{i phi} at the frequency
 k omega_c (a sin(theta + phi) = Re(-i a e^{i phi} e^{i theta})), solved by the harmonic
@@ -13,8 +13,8 @@ the linear model.
 A harmonic is a resonance where J(i k omega_c) is singular to working precision, or where,
 on an undamped set (D skew), k omega_c equals a natural frequency within that frequency's
 own error estimate: amplitude inf, the mode named. What the linear answer neglects is the
-model's own: the torsion gyrocompass's periodic response of its full equations and its
-measured linear limit live with it (gyro.systems.torsion_gyrocompass, docs/forced.md).
+model's own: a system's periodic response of its full equations and its measured linear
+limit live in its own module, which its forced levels' evaluators name (docs/forced.md).
 """
 from __future__ import annotations
 
@@ -126,7 +126,7 @@ def forced_response(model: Model, P, harmonics, method: str = "default") -> Forc
 
 def response_curve(model: Model, values: dict, harmonic, lo: float, hi: float, points: int) -> HarmonicResponse:
     """Amplitude against spin for one harmonic (s, k, a, phi): the declared spin parameter
-    (the torsion gyrocompass's H) swept linearly from lo to hi, each set at its own
+    (paper 003's H) swept linearly from lo to hi, each set at its own
     equilibrium; the axis is the spin angle's rate omega_c (rad/s)."""
     from gyro.equilibrium import equilibria
 

@@ -5,17 +5,17 @@
     gyro campbell MODEL [--spin NAME] [--spin-range LO HI] [--points N] [--harmonics K1,K2,...] [--set ...] [--json] [--out FILE.png]
     gyro stability-map MODEL --x NAME --x-range LO HI --y NAME --y-range LO HI [--x-log] [--y-log] --out FILE.png
     gyro params MODEL
-    gyro simulate gimbal_gyroscope [--set NAME=VALUE]... --t-end T [--points N] [--method NAME] [--json] [--out FILE.png]
+    gyro simulate MODEL [--set NAME=VALUE]... --t-end T [--points N] [--perturb NAME=VALUE]... [--method NAME] [--level L] [--base-rate ...] [--json] [--out FILE.png]
     gyro sweep MODEL --x NAME --x-range LO HI [--x-log] [--points N] [--method NAME] [--json] [--out FILE.png]
-    gyro stability gyrohorizoncompass [--set NAME=VALUE]... [--orbit] [--json]
-    gyro simulate gyrohorizoncompass [--set ...] --t-end T [--points N] [--perturb D1,D2,D3,D4] [--method NAME] [--json]
-    gyro map gyrohorizoncompass --x NAME=LO:HI:N --y NAME=LO:HI:N --out FILE.png [--json]
-    gyro forced torsion_gyrocompass --harmonic S:K:AMP[:PHASE]... [--set NAME=VALUE]... [--json] [--out FILE.png]
+    gyro stability MODEL [--set NAME=VALUE]... [--orbit] [--json]
+    gyro map MODEL --x NAME=LO:HI:N --y NAME=LO:HI:N --out FILE.png [--json]
+    gyro forced MODEL --harmonic S:K:AMP[:PHASE]... [--set NAME=VALUE]... [--json] [--out FILE.png]
     gyro unbalance MODEL --force-x NAME --force-y NAME --magnitude ME [--phase PHI] [--spin NAME] --spin-range LO HI [--points N] [--set ...] [--json] [--out FILE.png]
     gyro scene MODEL QUESTION --tol REL [--set NAME=VALUE]... [--modes I,J,...] [--horizon T] [--json]
 
 MODEL is a generated model's name, an emitted folder DIR/<name>, or a model file PATH.py
-(derived on first use). Bad input prints one line on stderr naming the parameter and exits with code 2; a
+(derived on first use). A command that needs a declaration the model lacks (a spin angle,
+conditions, levels) says so in one line; its --help names the declaration. Bad input prints one line on stderr naming the parameter and exits with code 2; a
 numerical failure at valid input one line and exit 1.
 """
 from __future__ import annotations

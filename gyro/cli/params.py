@@ -21,10 +21,13 @@ def run(args) -> int:
         print(f"{p.name:<8} {p.default:>14.8g} {p.unit:<10} {p.description}")
     if model.aliases:  # every command prints the name above and takes these for it too
         print("also taken: " + ", ".join(f"{a} for {n}" for a, n in model.aliases.items()))
-    if model.name == "gimbal_gyroscope":  # a motion's initial conditions, for gyro simulate
-        from gyro.systems.gimbal_gyroscope import INITIAL
+    own = model.meta.get("simulate")  # a motion of the model's own (Model.simulate)
+    if own and own.get("initial"):  # its initial conditions, taken by gyro simulate as --set
+        from gyro.catalog import declared_module
 
-        print("initial conditions (gyro simulate; psi(0) = phi(0) = 0):")
-        for name, (unit, default, description) in INITIAL.items():
+        print(f"initial conditions (gyro simulate; {own['initial']}):")
+        for name, (unit, default, description) in declared_module(own["module"], f"{model.name}'s motion").INITIAL.items():
             print(f"{name:<8} {default:>14.8g} {unit:<10} {description}")
+    if own and own.get("usage"):
+        print(f"gyro simulate {model.name}: {own['usage']}")
     return 0

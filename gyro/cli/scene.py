@@ -33,8 +33,8 @@ def register(sub) -> None:
 
 
 EPS = 2.220446049250313e-16  # a double's relative rounding: no answer printed as one is closer
-MAX_PERIODS = 10_000  # of the fastest motion over a motion's horizon (the gyrohorizoncompass's
-# linear level: 350 periods of omega4 = 219.6 rad/s in 6 s, 3500 in 28 s, measured)
+MAX_PERIODS = 10_000  # of the fastest motion over a motion's horizon (a linear motion level of
+# the papers' models: 350 periods of omega4 = 219.6 rad/s in 6 s, 3500 in 28 s, measured)
 
 
 def _tol(text: str) -> float:

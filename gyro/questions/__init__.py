@@ -83,10 +83,9 @@ def evaluator_module(level):
     if not name:
         raise ParameterError(f"level {level.name}: its evaluator of kind {level.evaluator.get('kind')!r} names no "
                              "module (\"module\": a dotted name)")
-    try:
-        return importlib.import_module(name)
-    except ImportError as exc:
-        raise ParameterError(f"level {level.name}: its evaluator's module {name!r} cannot be imported ({exc})") from None
+    from gyro.catalog import declared_module
+
+    return declared_module(name, f"level {level.name}")
 
 
 def unknown_kind(question: str, level) -> ValueError:

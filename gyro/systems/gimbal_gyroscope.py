@@ -651,3 +651,35 @@ def motion_answer(motion: Motion, t, method: str = "closed_form", rtol: float = 
         return q, np.full(3, est * max(1.0, float(np.max(np.abs(q)))))
 
     return ode.two_tolerances(lambda r: integrate(motion, t, method, r, r * 1e-2, budget_s=BUDGET_SECONDS)[0], rtol)
+
+
+# ------------------------------------------------------------------ gyro simulate
+
+def simulate_command(model, args, cli):
+    """`gyro simulate gimbal_gyroscope` (the model's `simulate` declaration): the parameters
+    and the initial conditions INITIAL as --set NAME=VALUE, every input checked first; the
+    closed form (2.6) by default, or an integrator of METHODS. Returns the Trajectory."""
+    from gyro.models import Param
+
+    ic = {n: Param(n, u, d, desc, "real", (None, None)) for n, (u, d, desc) in INITIAL.items()}
+    sets = cli.sets(args.set)
+    known = [*model.param_names, *model.aliases, *ic]
+    for key in sets:
+        if key not in known:
+            raise ParameterError(f"unknown parameter {key!r} for {model.name}; known: {model.known_names()} "
+                                 f"{' '.join(ic)}")
+    values = model.parameters({k: v for k, v in sets.items() if k not in ic})
+    init = {}
+    for name, p in ic.items():
+        raw = sets.get(name, p.default)
+        try:
+            init[name] = float(raw)
+        except (TypeError, ValueError):
+            raise ParameterError(f"parameter {name}: not a number: {raw!r}") from None
+        p.check(init[name])
+    t, method = cli.times(args), cli.method(args, METHODS, "closed_form")
+    cli.png(args.out)
+    tr = trajectory(Motion(values, init["theta0"], init["dtheta0"], init["dpsi0"], init["dphi0"]), t, method)
+    if not (np.all(np.isfinite(tr.theta)) and np.all(np.isfinite(tr.psi)) and np.all(np.isfinite(tr.phi))):
+        raise FloatingPointError("a coordinate is not finite")
+    return tr

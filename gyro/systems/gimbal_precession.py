@@ -688,3 +688,33 @@ def motion_answer(motion: Motion, t, method: str, rtol: float = RTOL):
     b = bound(motion.params, m)
     ex = _scale(m)
     return np.stack([m.x, m.y], axis=-1), np.full(2, b * ex)
+
+
+# ------------------------------------------------------------------ gyro simulate
+
+def simulate_command(model, args, cli):
+    """`gyro simulate gimbal_precession --level LEVEL` (the model's `simulate` declaration):
+    every input checked first (names, numbers, --level, --base-rate, --t-end, --points,
+    --out, the initial angles away from +-90 deg), then integrated by the level. Returns
+    the PrecessionMotion."""
+    if args.level is None:
+        raise ParameterError(f"--level: required for {MODEL}; one of {', '.join(LEVELS)}")
+    if args.level not in LEVELS:
+        raise ParameterError(f"--level: unknown level {args.level!r}; known: {', '.join(LEVELS)}")
+    values = parameters(cli.sets(args.set))
+    terms = [_base_rate_item(item) for item in args.base_rate or []]
+    base = oscillating_base(values, terms) if terms else None
+    t = cli.times(args)
+    cli.png(args.out)
+    initial_state(args.level, values, base)  # the initial angles away from +-90 deg
+    return simulate(values, t, args.level, base=base)
+
+
+def _base_rate_item(item: str) -> Oscillation:
+    """One --base-rate NAME=AMP:FREQ[:PHASE] as an Oscillation, or ParameterError naming it."""
+    label = f"--base-rate {item!r}"
+    name, sep, spec = item.partition("=")
+    parts = spec.split(":")
+    if not sep or not name.strip() or len(parts) not in (2, 3):
+        raise ParameterError(f"{label}: expected NAME=AMP:FREQ[:PHASE] (NAME xi, eta or zeta)")
+    return oscillation(name.strip(), *parts, what=label)

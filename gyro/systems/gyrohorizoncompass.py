@@ -674,3 +674,31 @@ def motion_answer(motion: Motion, t, method: str = LINEAR, rtol: float = RTOL):
     y0 = ye + x0
     return ode.two_tolerances(lambda r: integrate(values, y0, t, method, r, r * 1e-2, budget_s=BUDGET_SECONDS,
                                                   budget_steps=BUDGET_STEPS)[:, :4], rtol)
+
+
+# ------------------------------------------------------------------ gyro simulate
+
+ANGLES = ("alpha", "beta", "gamma", "epsilon")
+
+
+def simulate_command(model, args, cli):
+    """`gyro simulate gyrohorizoncompass` (the model's `simulate` declaration): every input
+    checked first (names, numbers, equilibrium, --perturb as D1,D2,D3,D4 or NAME=VALUE
+    over ANGLES, --t-end, --points, --method, --out), then integrated. Returns the
+    AngleTrajectory."""
+    values = parameters(cli.sets(args.set))
+    perturb = [0.0] * 4
+    if args.perturb is not None and (len(args.perturb) > 1 or "=" in args.perturb[0]):
+        for name, raw in cli.perturb_items(args.perturb).items():
+            if name not in ANGLES:
+                raise ParameterError(f"--perturb {name}: the gyrohorizoncompass's offsets are of "
+                                     f"{', '.join(ANGLES)} (rad, at rest)")
+            perturb[ANGLES.index(name)] = finite_number(f"--perturb {name}", raw)
+    elif args.perturb is not None:
+        parts = args.perturb[0].split(",")
+        if len(parts) != 4:
+            raise ParameterError(f"--perturb: expected four numbers D1,D2,D3,D4, got {args.perturb!r}")
+        perturb = [finite_number(f"--perturb {n}", p) for n, p in zip(ANGLES, parts)]
+    t, method = cli.times(args), cli.method(args, METHODS, "DOP853")
+    cli.png(args.out)
+    return trajectory(values, t, perturb, method)

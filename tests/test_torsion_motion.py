@@ -65,7 +65,7 @@ def test_the_linear_motion_is_the_exponential_of_the_linearised_equations(tg):
 
     mo = tm.Motion(tg.defaults, gamma1_0=1e-3, beta_d0=0.1, x1_0=1e-6)
     z = ca.SX.sym("z", 20)
-    J = np.asarray(ca.Function("J", [z], [ca.jacobian(mo.reduced_rhs(z), z)])(np.zeros(20)))
+    J = np.asarray(ca.Function("J", [z], [ca.jacobian(mo.reduced.rhs(z), z)])(np.zeros(20)))
     A = mo.first_order
     assert np.max(np.abs(A - J)) <= 1e-10 * np.max(np.abs(A))
     t = np.linspace(0.0, HORIZON, 11)
@@ -186,3 +186,35 @@ def test_the_committed_map_holds_the_bound_and_shows_its_cap(tg):
     assert past and max(c["error_over_uncapped_bound"] for c in past) >= 1.0
     assert m["declared"] == {k: hierarchy.get(tg, k).cost for k in ("linear_motion", "nonlinear_motion")}
     assert m["seconds_median"]["linear_motion"] < m["seconds_median"]["nonlinear_motion"]
+
+
+def _spin_free_rate(v: dict, g: dict, gd: dict) -> float:
+    """r2 - gamma3' of (1.6) by the frames, written out here (an independent route): the
+    Earth rate (1.3) and the casing rate p (1.5) in the casing, frames (1.2), (1.6)."""
+    def rot(axis, a):
+        c, s = np.cos(a), np.sin(a)
+        return np.array({"x": [[1, 0, 0], [0, c, -s], [0, s, c]], "y": [[c, 0, s], [0, 1, 0], [-s, 0, c]],
+                         "z": [[c, -s, 0], [s, c, 0], [0, 0, 1]]}[axis])
+
+    phi = np.radians(v["phi"])
+    u = v["u"] * np.array([0.0, np.cos(phi), np.sin(phi)])
+    S = rot("z", g["alpha"]) @ rot("x", g["beta"]) @ rot("y", g["gamma"])
+    p = (S.T @ (u + gd["alpha"] * np.array([0, 0, 1.0]))
+         + gd["beta"] * np.array([np.cos(g["gamma"]), 0, np.sin(g["gamma"])]) + gd["gamma"] * np.array([0, 1.0, 0]))
+    R = rot("z", g["gamma1"]) @ rot("x", g["gamma2"])
+    return float((R.T @ (p + gd["gamma1"] * np.array([0, 0, 1.0])) + gd["gamma2"] * np.array([1.0, 0, 0]))[1])
+
+
+def test_the_emitted_spin_rate_is_the_integral_by_the_frames(tg):
+    """gamma3' of the reduced state (the emitted `cyclic_rates`, dL/dgamma3' = H solved) is
+    H/C less the rotor's spin-free rate by the frames (1.2)-(1.6), to rounding, on states far
+    from the equilibrium (angles to 0.3 rad, rates to 2 rad/s) and at 10x the Earth rate."""
+    rng = np.random.default_rng(7)
+    for scale in (1e-3, 0.3):
+        values = {**tg.defaults, "u": 10 * tg.defaults["u"]}
+        S = tm.ReducedState(tg, values)
+        x, xd = rng.normal(size=10) * scale, rng.normal(size=10) * 2.0
+        Y = S.state(x, xd)
+        g, gd = dict(zip(S.coords, Y[:S.nq])), dict(zip(S.coords, Y[S.nq:]))
+        want = values["H"] / values["C"] - _spin_free_rate(values, g, gd)
+        assert Y[S.nq + S.k3] == pytest.approx(want, rel=4 * np.finfo(float).eps)

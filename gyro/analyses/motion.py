@@ -10,11 +10,13 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
 from gyro import ode
 from gyro.errors import ParameterError
+from gyro.kernels import function
 
 METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")
 RTOL, ATOL = 1e-10, 1e-12
@@ -157,3 +159,185 @@ def simulate(model, values: dict, offsets: dict, t: np.ndarray, method: str = "D
                   coordinates=list(model.meta["coordinates"]), units=[units.get(c, "") for c in model.meta["coordinates"]],
                   q=sol.y[:n].T.copy(), qd=sol.y[n:].T.copy(), params=dict(values), perturb=dict(offsets),
                   equilibrium=st.equilibrium, seconds=time.perf_counter() - t0)
+
+
+# ----------------------------------------------------------------------------- the reduced state
+class ReducedState:
+    """One set's state about its reference in the operator's coordinates (metadata
+    'reduced'): the set P and its values, the equilibrium qe, the coordinates and the
+    reduced ones' indices ri, the cyclic ones' ci, the reference (q_ref, qd_ref; the emitted
+    `reference_state`). `state(x, xd)` is the full state (q, q') of reduced displacements x
+    and rate offsets xd: q = q_ref + x and q' = qd_ref + xd on the reduced coordinates (a
+    steady coordinate keeps its declared rate plus xd), the cyclic coordinates' rates from
+    their momenta (the emitted `cyclic_rates`: for the torsion gyrocompass gamma3' from the
+    integral C r2 = H, (2.3))."""
+
+    def __init__(self, model, values: dict):
+        from gyro.equilibrium import equilibrium
+
+        meta = model.meta
+        if any(i["name"] == "time" for i in meta["functions"]["forcing"]["inputs"]):
+            raise ParameterError(f"{model.name}: its equations hold the time explicitly: no reduced motion about "
+                                 "a reference (the linear motion needs autonomous equations)")
+        self.model = model
+        self.P = model.vector(values)
+        self.values = model.parameters(values)
+        self.qe = equilibrium(model, self.P) if meta["equilibrium_coordinates"] else np.zeros(0)
+        self.coords = list(meta["coordinates"])
+        self.ri = np.array([self.coords.index(c) for c in meta["reduced"]], int)
+        self.ci = [self.coords.index(c) for c in meta.get("cyclic", {})]
+        self.nq, self.n = len(self.coords), len(self.ri)
+        st = start(model, self.P, {})
+        self.q_ref, self.qd_ref = st.q_ref, st.qd_ref
+        if self.ci and "cyclic_rates" not in meta["functions"]:
+            raise ParameterError(f"{model.name}: emitted without cyclic_rates (derive it again with this version)")
+
+    def state(self, x, xd, lib=np):
+        """The full state (q, q') of reduced displacements x and rate offsets xd; with
+        lib = casadi, of symbols (an SX column)."""
+        if lib is np:
+            q, qd = self.q_ref.copy(), self.qd_ref.copy()
+            q[self.ri] += x
+            qd[self.ri] += xd
+            if self.ci:
+                with np.errstate(all="ignore"):
+                    rates = function(self.model, "cyclic_rates")(self.P[None], q[None], qd[None])[0]
+                qd[self.ci] = np.asarray(rates, float).reshape(-1)
+            return np.concatenate([q, qd])
+        q, qd = [float(v) for v in self.q_ref], [float(v) for v in self.qd_ref]
+        for j, i in enumerate(self.ri):
+            q[i], qd[i] = q[i] + x[j], qd[i] + xd[j]
+        if self.ci:
+            rates = self.model.casadi.cyclic_rates(lib.DM(self.P), lib.vertcat(*q), lib.vertcat(*qd))
+            for j, i in enumerate(self.ci):
+                qd[i] = rates[j]
+        return lib.vertcat(*q, *qd)
+
+    def state_jacobian(self, Y: np.ndarray) -> np.ndarray:
+        """d state / d (x, xd) at full states Y (2 nq, N): (N, 2 nq, 2 n): the identity on the
+        reduced rows; the cyclic rates' rows their exact derivatives (CasADi, through
+        `cyclic_rates`)."""
+        N, n, nq = Y.shape[1], self.n, self.nq
+        dY = np.zeros((N, 2 * nq, 2 * n))
+        dY[:, np.concatenate([self.ri, nq + self.ri]), np.arange(2 * n)] = 1.0
+        if self.ci:
+            J = self._rates_jacobian.map(N)(Y)  # (cyclic, 2 nq) per set, stacked along columns
+            J = np.asarray(J, float).reshape(len(self.ci), N, 2 * nq).transpose(1, 0, 2)
+            cols = np.concatenate([self.ri, nq + self.ri])
+            for j, i in enumerate(self.ci):
+                dY[:, nq + i, :] = J[:, j, cols]
+        return dY
+
+    @cached_property
+    def _rates_jacobian(self):
+        import casadi as ca
+
+        y = ca.SX.sym("y", 2 * self.nq)
+        rates = self.model.casadi.cyclic_rates(ca.DM(self.P), y[:self.nq], y[self.nq:])
+        return ca.Function("cyclic_rates_jacobian", [y], [ca.jacobian(rates, y)])
+
+    @cached_property
+    def first_order(self) -> np.ndarray:
+        """A (2n, 2n) of z' = A z, z = (x, x'), from the generated operator at the reference."""
+        from gyro.equilibrium import operators
+
+        args = (self.qe[None],) if self.qe.size else (np.zeros((1, 0)),)
+        M, D, K = (np.asarray(X, float)[0] for X in operators(self.model, self.P[None], *args))
+        n = self.n
+        A = np.zeros((2 * n, 2 * n))
+        A[:n, n:] = np.eye(n)
+        A[n:, :n] = -np.linalg.solve(M, K)
+        A[n:, n:] = -np.linalg.solve(M, D)
+        return A
+
+    @cached_property
+    def rhs(self):
+        """z -> f(z) (CasADi Function, 2n -> 2n): the full equations in the reduced state, the
+        cyclic rates from their momenta, the inputs zero."""
+        import casadi as ca
+
+        sym = ode.symbolic(self.model)
+        z = ca.SX.sym("z", 2 * self.n)
+        Y = self.state(ca.vertsplit(z[:self.n]), ca.vertsplit(z[self.n:]), ca)
+        ydot = ca.substitute([sym.ydot], [sym.y, sym.p, *sym.inputs],
+                             [Y, ca.DM(self.P), *[ca.DM.zeros(v.numel()) for v in sym.inputs]])[0]
+        return ca.Function("reduced_rhs", [z], [ca.vertcat(z[self.n:], ydot[self.nq + self.ri])])
+
+
+def uniform_times(t) -> np.ndarray:
+    t = np.asarray(t, float)
+    if t.ndim != 1 or t.size < 2 or t[0] != 0.0 or np.any(np.diff(t) <= 0):
+        raise ValueError("the sample times must be increasing from t = 0")
+    if not np.allclose(np.diff(t), t[1] - t[0], rtol=1e-9, atol=0.0):
+        raise ValueError("the linear motion takes uniform sample times")
+    return t
+
+
+def linear_motion(red: ReducedState, z0: np.ndarray, t, corrections: int = 2, fine: int = 32):
+    """The linear motion z' = A z from z0 and its correction at the sample times t (uniform
+    from 0): (z_L, e, steps), each (times, 2n). The linear motion is propagated exactly
+    (scipy.signal.lsim: the exponential of A) over a fine grid, `fine` samples per shortest
+    period 2 pi/(2 omega_max) of the remainder's quadratic terms; e after `corrections`
+    steps of Picard's iteration e' = A e + r(z_L + e), e(0) = 0, r(z) = f(z) - A z (the
+    terms of second and higher order, and the reference's residual f(0)), each the linear
+    system driven by the remainder (Duhamel's integral, r linear between the samples).
+    `steps` is the fine grid's steps per sample interval."""
+    from scipy.signal import StateSpace, lsim
+
+    t = uniform_times(t)
+    A = red.first_order
+    n2 = A.shape[0]
+    w_max = float(np.max(np.abs(np.linalg.eigvals(A))))
+    h = 2 * np.pi / (2 * w_max) / fine if w_max > 0 else t[-1]
+    per = max(1, int(np.ceil((t[1] - t[0]) / h)))
+    tf = np.linspace(0.0, t[-1], (t.size - 1) * per + 1)
+    sys = StateSpace(A, np.eye(n2), np.eye(n2), np.zeros((n2, n2)))
+    zL = lsim(sys, np.zeros((tf.size, n2)), tf, X0=z0, interp=True)[2]
+    f = red.rhs.map(tf.size)
+    e = np.zeros_like(zL)
+    for _ in range(corrections):
+        z = zL + e
+        r = np.asarray(f(z.T)).T - z @ A.T
+        e = lsim(sys, r, tf, X0=np.zeros(n2), interp=True)[2]
+    return zL[::per], e[::per], per
+
+
+def integrate_reduced(red: ReducedState, z0: np.ndarray, t, method: str = "DOP853", rtol: float = 1e-9,
+                      scale: np.ndarray | None = None, floor: float = 100.0) -> np.ndarray:
+    """The full equations integrated from the reduced state z0: the reduced coordinates
+    q_ref + x at the times t (times, n). `scale` (2: the displacements' and the rates' size)
+    sets the absolute tolerances, 1e-3 rtol of it (default: the linear motion's largest |x|,
+    |x'|), so a small perturbation is resolved, but not below `floor` eps of the reference's
+    largest coordinate (and that times the fastest frequency for the rates): there the
+    state's rounding, amplified by stiff springs, would stall the steps."""
+    from scipy.integrate import solve_ivp
+
+    t = np.asarray(t, float)
+    n = red.n
+    if scale is None:
+        zL = linear_motion(red, z0, t, corrections=0)[0]
+        scale = np.array([np.max(np.abs(zL[:, :n])), np.max(np.abs(zL[:, n:]))])
+    size = np.max(np.abs(red.q_ref[red.ri])) if n else 0.0
+    lo = floor * np.finfo(float).eps * size
+    w_max = float(np.max(np.abs(np.linalg.eigvals(red.first_order))))
+    atol = np.empty(2 * red.nq)
+    atol[:red.nq] = max(1e-3 * rtol * scale[0], lo, np.finfo(float).tiny)
+    atol[red.nq:] = max(1e-3 * rtol * scale[1], lo * w_max, np.finfo(float).tiny)
+    sol = solve_ivp(ode.numpy_rhs(red.model, red.P), (t[0], t[-1]), red.state(z0[:n], z0[n:]), method=method,
+                    t_eval=t, rtol=rtol, atol=atol)
+    if not sol.success:
+        raise RuntimeError(f"{method}: {sol.message}")
+    return sol.y[red.ri].T
+
+
+def group_max(v: np.ndarray, units: list) -> np.ndarray:
+    """Per entry of x (n) or (x, x') (2n), the largest of its unit group (displacements in m,
+    in rad, their rates; `units` per reduced coordinate): the scale of a per-coordinate
+    estimate."""
+    n = len(units)
+    out = np.empty_like(v)
+    for half in range(0, v.size, n):
+        for unit in set(units):
+            idx = [half + j for j, u in enumerate(units) if u == unit]
+            out[idx] = np.max(v[idx])
+    return out

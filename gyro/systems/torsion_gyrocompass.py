@@ -43,6 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
+from gyro.analyses import motion as generic
 from gyro.analyses.forced import harmonic_input as forced_input
 from gyro.analyses.harmonic import harmonic_response
 from gyro.analyses.spin import spin_rate
@@ -96,122 +97,42 @@ class Motion:
     @cached_property
     def reduced(self):
         """The set's equilibrium and full state (ReducedState, below)."""
-
         model = load(MODEL)
         if tuple(model.meta["reduced"]) != REDUCED:
             raise RuntimeError(f"{MODEL}: the reduced coordinates changed; REDUCED must follow them")
         return ReducedState(model, self.params)
 
-    @cached_property
+    @property
     def first_order(self) -> np.ndarray:
         """A (2n, 2n) of z' = A z, z = (x, x'), from the generated operator at the equilibrium."""
-        from gyro.equilibrium import operators
-
-        S = self.reduced
-        M, D, K = (np.asarray(X, float)[0] for X in operators(S.model, S.P[None], S.qe[None]))
-        n = S.n
-        A = np.zeros((2 * n, 2 * n))
-        A[:n, n:] = np.eye(n)
-        A[n:, :n] = -np.linalg.solve(M, K)
-        A[n:, n:] = -np.linalg.solve(M, D)
-        return A
-
-    @cached_property
-    def reduced_rhs(self):
-        """z -> f(z) (CasADi Function, 2n -> 2n): the full equations in the reduced state, the
-        spin's rate from its integral, no imperfections."""
-        import casadi as ca
-
-        from gyro import ode
-
-        S = self.reduced
-        sym = ode.symbolic(S.model)
-        z = ca.SX.sym("z", 2 * S.n)
-        Y = S.state(ca.vertsplit(z[:S.n]), ca.vertsplit(z[S.n:]), ca)
-        ydot = ca.substitute([sym.ydot], [sym.y, sym.p, *sym.inputs],
-                             [Y, ca.DM(S.P), *[ca.DM.zeros(v.numel()) for v in sym.inputs]])[0]
-        return ca.Function("reduced_rhs", [z], [ca.vertcat(z[S.n:], ydot[S.nq + S.ri])])
+        return self.reduced.first_order
 
     @property
     def z0(self) -> np.ndarray:
         return np.concatenate([self.x0, self.xd0])
 
 
-def _uniform(t) -> np.ndarray:
-    t = np.asarray(t, float)
-    if t.ndim != 1 or t.size < 2 or t[0] != 0.0 or np.any(np.diff(t) <= 0):
-        raise ValueError("the sample times must be increasing from t = 0")
-    if not np.allclose(np.diff(t), t[1] - t[0], rtol=1e-9, atol=0.0):
-        raise ValueError("the linear motion takes uniform sample times")
-    return t
-
-
 def linear_motion(motion: Motion, t):
     """The linear motion and its correction at the sample times t (uniform from 0): (z_L, e,
     steps), each (times, 2n), e after CORRECTIONS steps of Picard's iteration
-    e' = A e + r(z_L + e), e(0) = 0, r(z) = f(z) - A z; steps the fine grid's steps per
-    sample interval."""
-    from scipy.signal import StateSpace, lsim
-
-    t = _uniform(t)
-    A = motion.first_order
-    n2 = A.shape[0]
-    w_max = float(np.max(np.abs(np.linalg.eigvals(A))))
-    h = 2 * np.pi / (2 * w_max) / FINE
-    per = max(1, int(np.ceil((t[1] - t[0]) / h)))
-    tf = np.linspace(0.0, t[-1], (t.size - 1) * per + 1)
-    sys = StateSpace(A, np.eye(n2), np.eye(n2), np.zeros((n2, n2)))
-    zero = np.zeros((tf.size, n2))
-    zL = lsim(sys, zero, tf, X0=motion.z0, interp=True)[2]
-    f = motion.reduced_rhs.map(tf.size)
-    e = np.zeros_like(zL)
-    for _ in range(CORRECTIONS):  # Picard's iteration about the linear motion: e' = A e + r(z_L + e)
-        z = zL + e
-        r = np.asarray(f(z.T)).T - z @ A.T
-        e = lsim(sys, r, tf, X0=np.zeros(n2), interp=True)[2]
-    return zL[::per], e[::per], per
+    (gyro.analyses.motion.linear_motion)."""
+    return generic.linear_motion(motion.reduced, motion.z0, t, CORRECTIONS, FINE)
 
 
 def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-9, scale: np.ndarray | None = None):
     """The full 11-coordinate equations integrated from the motion's state: the reduced
-    coordinates q0 + x at the times t (times, n). `scale` (2: the displacements' and the
-    rates' size) sets the absolute tolerances, 1e-3 rtol of it (default: the linear motion's
-    largest |x|, |x'|), so a small perturbation is resolved, but not below FLOOR eps of the
-    equilibrium's largest coordinate (and that times the fastest frequency for the rates):
-    there the state's rounding, amplified by the stiff bearings, would stall the steps."""
-    from scipy.integrate import solve_ivp
-
-    from gyro import ode
-
-    S = motion.reduced
-    t = np.asarray(t, float)
-    n = S.n
-    A = motion.first_order
+    coordinates q0 + x at the times t (times, n); the absolute tolerances from `scale`, not
+    below FLOOR eps of the equilibrium (gyro.analyses.motion.integrate_reduced)."""
     if scale is None:
         zL = linear_motion(motion, t)[0]
+        n = motion.reduced.n
         scale = np.array([np.max(np.abs(zL[:, :n])), np.max(np.abs(zL[:, n:]))])
-    floor = FLOOR * np.finfo(float).eps * np.max(np.abs(S.q_ref[S.ri]))
-    w_max = float(np.max(np.abs(np.linalg.eigvals(A))))
-    atol = np.empty(2 * S.nq)
-    atol[:S.nq] = max(1e-3 * rtol * scale[0], floor)
-    atol[S.nq:] = max(1e-3 * rtol * scale[1], floor * w_max)
-    sol = solve_ivp(ode.numpy_rhs(S.model, S.P), (t[0], t[-1]), S.state(motion.x0, motion.xd0), method=method,
-                    t_eval=t, rtol=rtol, atol=atol)
-    if not sol.success:
-        raise RuntimeError(f"{method}: {sol.message}")
-    return sol.y[S.ri].T
+    return generic.integrate_reduced(motion.reduced, motion.z0, t, method, rtol, scale, FLOOR)
 
 
 def _group_max(v: np.ndarray) -> np.ndarray:
-    """Per entry of x (n) or (x, x') (2n), the largest of its unit group (displacements in m,
-    in rad, their rates): the scale the estimate takes per coordinate."""
-    n = len(REDUCED)
-    out = np.empty_like(v)
-    for half in range(0, v.size, n):
-        for unit in set(_UNIT.values()):
-            idx = [half + j for j, c in enumerate(REDUCED) if _UNIT[c] == unit]
-            out[idx] = np.max(v[idx])
-    return out
+    """Per entry of x (n) or (x, x') (2n), the largest of its unit group (m, rad, their rates)."""
+    return generic.group_max(v, [_UNIT[c] for c in REDUCED])
 
 
 def linear_answer(motion: Motion, t, cap: float = CAP):
@@ -282,107 +203,17 @@ def linear_limit() -> dict:
 
 
 # ----------------------------------------------------------------------------- nonlinear check
-def _rot(axis: str, a, lib=np):
-    c, s = lib.cos(a), lib.sin(a)
-    m = {"x": [[1, 0, 0], [0, c, -s], [0, s, c]], "y": [[c, 0, s], [0, 1, 0], [-s, 0, c]],
-         "z": [[c, -s, 0], [s, c, 0], [0, 0, 1]]}[axis]
-    if lib is np:
-        return np.array(m)
-    import casadi as ca
-
-    return ca.blockcat(m)
-
-
-ANGLES = ("alpha", "beta", "gamma", "gamma1", "gamma2")  # the angles the spin-free rate depends on
-
-
-def _spin_free_rate(values: dict, g: dict, gd: dict, lib=np):
-    """r2 - gamma3' of (1.6): the rotor's absolute rate on its spin axis without the spin,
-    from the Earth rate (1.3) and the casing rate p (1.5), frames (1.2), (1.6); with
-    lib = casadi, the same as an expression of symbols."""
-    phi = values["phi"] * np.pi / 180
-    vec = np.array if lib is np else (lambda v: __import__("casadi").vertcat(*v))
-    u = values["u"] * vec([0.0, lib.cos(phi), lib.sin(phi)])
-    S = _rot("z", g["alpha"], lib) @ _rot("x", g["beta"], lib) @ _rot("y", g["gamma"], lib)
-    p = (S.T @ (u + gd["alpha"] * vec([0, 0, 1.0]))
-         + gd["beta"] * vec([lib.cos(g["gamma"]), 0, lib.sin(g["gamma"])]) + gd["gamma"] * vec([0, 1.0, 0]))
-    R = _rot("z", g["gamma1"], lib) @ _rot("x", g["gamma2"], lib)
-    r = (R.T @ (p + gd["gamma1"] * vec([0, 0, 1.0])) + gd["gamma2"] * vec([1.0, 0, 0]))[1]
-    return float(r) if lib is np else r
-
-
-_RATE_JACOBIAN: dict = {}
-
-
-def _spin_free_rate_jacobian():
-    """A CasADi Function (angles (5), their rates (5), u, phi) -> d(spin-free rate)/d(angles,
-    rates) (1 x 10), ANGLES' order: the derivative gamma3's rate from its integral takes."""
-    if "f" not in _RATE_JACOBIAN:
-        import casadi as ca
-
-        a, ad, u, phi = ca.SX.sym("a", 5), ca.SX.sym("ad", 5), ca.SX.sym("u"), ca.SX.sym("phi")
-        r = _spin_free_rate({"u": u, "phi": phi}, dict(zip(ANGLES, ca.vertsplit(a))),
-                            dict(zip(ANGLES, ca.vertsplit(ad))), ca)
-        _RATE_JACOBIAN["f"] = ca.Function("spin_free_rate_jacobian", [a, ad, u, phi],
-                                          [ca.jacobian(r, ca.vertcat(a, ad))])
-    return _RATE_JACOBIAN["f"]
-
-
-class ReducedState:
-    """The full 11-coordinate state about the relative equilibrium of one set: the set P (and
-    its values), the equilibrium qe, the coordinates (11) and the reduced ones' indices ri
-    (10), gamma3's index k3, the equilibrium as all 11 coordinates q_ref; `state(x, xd)` the
-    full state (q, q') of the reduced coordinates' displacements x and rates xd about it,
-    gamma3's rate from the integral C r2 = H (the forced response's and the free motion's,
-    gyro.systems.torsion_gyrocompass)."""
+class ReducedState(generic.ReducedState):
+    """The full 11-coordinate state about the relative equilibrium of one set
+    (gyro.analyses.motion.ReducedState): gamma3's rate from the integral C r2 = H (2.3), the
+    emitted `cyclic_rates`, bit for bit the rate the frames (1.2)-(1.6) give (it replaced
+    their hand-typed form here; tests/test_torsion_motion.py); k3 gamma3's index."""
 
     def __init__(self, model: Model, values: dict):
-        from gyro.equilibrium import equilibrium
-
         if model.name != MODEL:
             raise ParameterError(f"{model.name}: the periodic response of the full equations is {MODEL}'s only")
-        self.model = model
-        self.P = model.vector(values)
-        self.values = model.parameters(values)
-        self.qe = equilibrium(model, self.P)
-        self.coords = model.meta["coordinates"]
-        self.ri = np.array([self.coords.index(c) for c in model.meta["reduced"]])
-        self.nq, self.n = len(self.coords), len(self.ri)
+        super().__init__(model, values)
         self.k3 = self.coords.index("gamma3")
-        self.q_ref = np.zeros(self.nq)
-        for name, v in zip(model.meta["equilibrium_coordinates"], self.qe):
-            self.q_ref[self.coords.index(name)] = v
-
-    def state(self, x, xd, lib=np):
-        """The full state (q, q') of reduced displacements x and rates xd; with lib = casadi,
-        of symbols (an SX column)."""
-        if lib is np:
-            q = self.q_ref.copy()
-            q[self.ri] += x
-            qd = np.zeros(self.nq)
-            qd[self.ri] = xd
-        else:
-            q, qd = list(self.q_ref), [0.0] * self.nq
-            for j, i in enumerate(self.ri):
-                q[i], qd[i] = q[i] + x[j], xd[j]
-        g, gd = dict(zip(self.coords, q)), dict(zip(self.coords, qd))
-        qd[self.k3] = self.values["H"] / self.values["C"] - _spin_free_rate(self.values, g, gd, lib)
-        return np.concatenate([q, qd]) if lib is np else lib.vertcat(*q, *qd)
-
-    def state_jacobian(self, Y: np.ndarray) -> np.ndarray:
-        """d state / d (x, xd) at full states Y (2 nq, N): (N, 2 nq, 2 n), the identity on the
-        reduced rows, and gamma3's rate from the integral, minus the spin-free rate, whose
-        derivative in the angles and their rates is exact (CasADi, _spin_free_rate_jacobian)."""
-        N, n, nq = Y.shape[1], self.n, self.nq
-        dY = np.zeros((N, 2 * nq, 2 * n))
-        dY[:, np.concatenate([self.ri, nq + self.ri]), np.arange(2 * n)] = 1.0
-        ia = [self.coords.index(c) for c in ANGLES]
-        red = [list(self.ri).index(i) for i in ia]
-        dr = np.asarray(_spin_free_rate_jacobian().map(N)(Y[ia], Y[[nq + i for i in ia]], self.values["u"],
-                                                          self.values["phi"] * 1.0)).reshape(N, 10)
-        dY[:, nq + self.k3, red] = -dr[:, :5]
-        dY[:, nq + self.k3, [n + i for i in red]] = -dr[:, 5:]
-        return dY
 
 
 class _Periodic(ReducedState):

@@ -12,9 +12,11 @@
  * every sign as computed and the count is written; -1 otherwise, and -2 at every point of a
  * set whose M or K is not symmetric or D not skew (bearing damping: no such count). Where
  * the coordinates fall in two groups, K and M within and D across (groups()), the same
- * count runs on the real symmetric T^H A T (count_real); and the separation is first bounded
- * by ||L^-1||_F ||B^-1 L^-1||_F, the product formed only where that does not decide
- * (separation_bound): either way the test of the product's own norm holds.
+ * count runs on the real symmetric T^H A T (count_real), whose separation is bounded first
+ * in O(n^2) from L's comparison matrix, then as the complex count's is; there, and in
+ * count_one, by ||L^-1||_F ||B^-1 L^-1||_F before the product is formed (separation_bound:
+ * the product's n^3 only where that does not decide). Each bounds ||(L B L^H)^-1||_2 from
+ * above, as the product's norm does, so each proves the signs by the same Weyl argument.
  * M, D, K are (sets, n, n) row-major, set b's the row rows[b] (b where rows is NULL), w (N, P),
  * out (N, P); n <= 32. Complex numbers are pairs
  * of doubles (C99's complex product calls a library routine for its infinities). */
@@ -329,6 +331,35 @@ static double count_real(long n, const double *M, const double *Ds, const double
         }
         k += size;
     }
+    double pert = 8.0 * n * eps * (sqrt(normA) + growth) + 64.0 * eps * sqrt(magF);
+    /* first in O(n^2): |L^-1| <= C^-1 entrywise for the comparison matrix C of L (unit
+     * diagonal, -|l_ij| below it), so ||L^-1||_inf <= max(C^-1 e) and ||L^-1||_1 <=
+     * max(C^-T e), both sums of positive terms (their rounding within 2 n^2 eps, covered by
+     * the factor); ||(L B L^T)^-1||_2 <= ||L^-1||_1 ||L^-1||_inf max_b ||B_b^-1||_F */
+    {
+        double up[NMAX], lo[NMAX], rmax = 0.0, cmax = 0.0, bmax = 0.0;
+        for (long i = 0; i < n; i++) {
+            double v = 1.0;
+            for (long j = 0; j < i; j++) v += fabs(a[i][j]) * up[j];
+            up[i] = v;
+            rmax = fmax(rmax, v);
+        }
+        for (long i = n - 1; i >= 0; i--) {
+            double v = 1.0;
+            for (long j = i + 1; j < n; j++) v += fabs(a[j][i]) * lo[j];
+            lo[i] = v;
+            cmax = fmax(cmax, v);
+        }
+        for (long i = 0; i < n;) {  /* per block, ||B_b^-1||_F from its inverse's rows */
+            long o = (bsize[i] == 2) ? i + 1 : i;
+            double f2 = binv[i][0] * binv[i][0] + binv[i][1] * binv[i][1];
+            if (o > i) f2 += binv[o][0] * binv[o][0] + binv[o][1] * binv[o][1];
+            bmax = fmax(bmax, sqrt(f2));
+            i = o + 1;
+        }
+        double bound = rmax * cmax * bmax * (1.0 + 16.0 * (double)(n * n) * eps);
+        if (isfinite(bound) && 2.0 * pert < 1.0 / bound) return (double)negative;
+    }
     /* X = L^-1 (L unit lower triangular, below a's diagonal; zero within a 2 x 2 block) */
     double x[NMAX][NMAX], z[NMAX][NMAX], xF = 0.0, zF = 0.0, lF = (double)n;
     for (long j = 0; j < n; j++) sa[j] = 0.0;
@@ -364,7 +395,6 @@ static double count_real(long n, const double *M, const double *Ds, const double
         }
         i = o + 1;
     }
-    double pert = 8.0 * n * eps * (sqrt(normA) + growth) + 64.0 * eps * sqrt(magF);
     if (2.0 * pert < 1.0 / separation_bound(n, xF, zF)) return (double)negative;
     double yF = 0.0;  /* ||X^T Z||_F: the inverse of L B L^T */
     for (long i = 0; i < n; i++)

@@ -232,21 +232,28 @@ def _say(out: np.ndarray, flags: np.ndarray, text) -> None:
         out[rows] = np.array([text(i) for i in range(flags.shape[1])], dtype=object)[j]
 
 
-# s per set on one core, on the scale of the methods' COST (linear_exact:default 3.6e-5 s):
-# a count (the compiled Bunch-Kaufman inertia, counts_at) and the rest of a certificate
-# (the equilibrium, the operator, the bookkeeping), from one run of
-# `python -m bench.levels --random-speed` (levels.json 'random_speed': one mode's certificate
-# 0.72x the default method's time, ten modes' 3.0x..4.2x). So the certificate leaves a cheap level
-# its advantage for one or two requested modes, and costs more than it for three and more
-COUNT_COST = 4.1e-6
-OPERATOR_COST = 8.7e-6
+# s per set on one core, on the scale of the methods' COST (linear_exact:default 3.6e-5 s): a
+# count (the compiled inertia, counts_at) and the rest of a certificate beside its counts (the
+# equilibrium, the operator, the count at 0, the bookkeeping), measured in one run of
+# `python -m bench.levels --random-speed 100000` (levels.json random_speed.certificate.declare)
+COUNT_COST = 2.1e-6
+OPERATOR_COST = 1.1e-5
+# The most requested modes for which the certified levels, tried before the exact operator,
+# answered faster than it alone in that run (random_speed.modes_1e-3: modes 1..k at 1e-3, each
+# set trying the levels in turn, a certificate for each). Beyond, a level's proof costs its
+# advantage: certificate_cost is infinite, and the exact operator, the cheaper proven
+# answer, is tried first (the cheap levels retired for that request).
+CERTIFIED_MODES = 2
 
 
 def certificate_cost(level, idx) -> float:
     """The certificate's seconds per set for the requested modes idx (0 for a level that
-    declares none): the operator, the count at 0 (K > 0) and two per requested mode."""
+    declares none): the rest of it and three counts for one mode, two more per mode; infinite
+    for more than CERTIFIED_MODES modes (retired: measured slower than the exact operator)."""
     if not level.evaluator.get("certify"):
         return 0.0
+    if len(idx) > CERTIFIED_MODES:
+        return float("inf")
     return OPERATOR_COST + COUNT_COST * (1 + 2 * len(idx))
 
 

@@ -547,8 +547,10 @@ def random_speed(n: int, seed: int = 36) -> dict:
     requested modes (1..k) at 1e-3, the selector with the certified levels tried first (the
     certificate's declared costs set to 0 and no retirement, for the run) against the exact
     operator alone (`among` it), per set, and the most modes up to which the first was the
-    faster (gyro.questions.frequencies CERTIFIED_MODES); and the certificate's parts alone
-    (`certificate_costs`: COUNT_COST, OPERATOR_COST)."""
+    faster (gyro.questions.frequencies CERTIFIED_MODES); the same for mode k alone, and the
+    modes for which the first was not the faster there (none may be, for a rule by the number
+    of modes to hold); and the certificate's parts alone (`certificate_costs`: COUNT_COST,
+    OPERATOR_COST)."""
     P = joint(n, seed)
     chunk = 10_000
     parts = [P[s:s + chunk] for s in range(0, n, chunk)]
@@ -564,6 +566,7 @@ def random_speed(n: int, seed: int = 36) -> dict:
         runs[key] = lambda p, tol=tol, opts=opts: select(TG, "frequencies", p, tol, opts)
     for k in ks:
         runs[f"certified_first_{k}"] = lambda p, k=k: _certified_first(p, list(range(1, k + 1)))
+        runs[f"certified_first_mode_{k}"] = lambda p, k=k: _certified_first(p, [k])
     seconds = {key: 0.0 for key in runs}
     used = {key: {} for key, _, _ in REQUESTS}
     for p in parts:
@@ -581,9 +584,12 @@ def random_speed(n: int, seed: int = 36) -> dict:
         out[key] = {"s_per_set": per[key], "ratio_to_exact": t_exact / per[key], "levels": used[key]}
     t_cf = [per[f"certified_first_{k}"] for k in ks]
     faster = [bool(t < per["exact_selected"]) for t in t_cf]
+    t_one = [per[f"certified_first_mode_{k}"] for k in ks]
     out["modes_1e-3"] = {"k": list(ks), "certified_first_s_per_set": t_cf,
                          "exact_alone_s_per_set": per["exact_selected"], "certified_first_faster": faster,
-                         "CERTIFIED_MODES": (faster + [False]).index(False)}
+                         "CERTIFIED_MODES": (faster + [False]).index(False),
+                         "mode_k_alone_certified_first_s_per_set": t_one,
+                         "modes_alone_not_faster": [k for k, t in zip(ks, t_one) if not t < per["exact_selected"]]}
     out["certificate"] = certificate_costs(parts[0], t_exact)
     return out
 

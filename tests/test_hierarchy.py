@@ -274,7 +274,8 @@ def test_the_selector_retires_the_certified_levels_where_their_proof_measured_sl
     the selector on the random spread at 1e-3 for modes 1..k with the certified levels tried
     first, against the exact operator alone; CERTIFIED_MODES is the most modes up to which
     the first was the faster, and beyond it the selector tries the exact operator first (a
-    certified level's proof costs its advantage there: retired). The declared costs of a
+    certified level's proof costs its advantage there: retired); each mode requested alone
+    was faster so, which a rule by the number of modes needs. The declared costs of a
     count and of the rest of a certificate are that run's, within the factor 2 by which the
     shared machine's load moved one run against another (the exact operator 10-21 us a set)."""
     from gyro.analyses.scene import candidates
@@ -287,9 +288,12 @@ def test_the_selector_retires_the_certified_levels_where_their_proof_measured_sl
     assert F.CERTIFIED_MODES == (faster + [False]).index(False) == measured["CERTIFIED_MODES"]
     for key in ("COUNT_COST", "OPERATOR_COST"):
         assert 0.5 < getattr(F, key) / run["certificate"]["declare"][key] < 2.0, key
+    # a rule by the number of modes: each mode alone measured faster by the certified levels
+    assert measured["modes_alone_not_faster"] == []
     for k in range(1, 11):
         first = candidates(tg, F, "frequencies", list(range(k)))[0]
         assert (first.name != "linear_exact:default") == (k <= F.CERTIFIED_MODES), k
+        assert candidates(tg, F, "frequencies", [k - 1])[0].name != "linear_exact:default", k  # mode k alone
     # the requests of the speed goals: one mode and two go to the certified levels, three
     # (--modes 1,2,4) and ten to the exact operator
     P = tg.vector()[None, :]

@@ -236,13 +236,13 @@ def _say(out: np.ndarray, flags: np.ndarray, text) -> None:
 # count (the compiled inertia, counts_at) and the rest of a certificate beside its counts (the
 # equilibrium, the operator, the count at 0, the bookkeeping), measured in one run of
 # `python -m bench.levels --random-speed 100000` (levels.json random_speed.certificate.declare)
-COUNT_COST = 2.1e-6
-OPERATOR_COST = 1.1e-5
+COUNT_COST = 1.7e-6
+OPERATOR_COST = 8.1e-6
 # The most requested modes for which the certified levels, tried before the exact operator,
 # answered faster than it alone in that run (random_speed.modes_1e-3: modes 1..k at 1e-3, each
-# set trying the levels in turn, a certificate for each). Beyond, a level's proof costs its
-# advantage: certificate_cost is infinite, and the exact operator, the cheaper proven
-# answer, is tried first (the cheap levels retired for that request).
+# set trying the levels in turn, a certificate for each; each mode alone was faster too).
+# Beyond, a level's proof costs its advantage: certificate_cost is infinite, and the exact
+# operator, the cheaper proven answer, is tried first (the cheap levels retired there).
 CERTIFIED_MODES = 2
 
 

@@ -533,11 +533,24 @@ def speed(quick: bool) -> dict:
     }
 
 
+REQUESTS = (("all_1e-3", 1e-3, {}), ("modes_1_2_4_1e-3", 1e-3, {"modes": [1, 2, 4]}),
+            ("modes_4_1e-3", 1e-3, {"modes": [4]}), ("all_1e-9", 1e-9, {}))
+
+
 def random_speed(n: int, seed: int = 36) -> dict:
     """The speed where it is used (issue 36): n random sets of the project's joint spread
     (`joint`), one core, each request against the exact operator by the default method on
-    the same sets in the same run (chunks of 10,000 sets), with the levels picked; and what
-    the certificate costs: the counts of one and of ten modes on the formulas' answers."""
+    the same sets in the same run, with the levels picked. The runs are interleaved chunk by
+    chunk (10,000 sets), so that the load of a shared machine falls on all of them alike.
+
+    Beside the requests (REQUESTS), what the selector's order rests on: for k = 1..10
+    requested modes (1..k) at 1e-3, the selector with the certified levels tried first (the
+    certificate's declared costs set to 0 and no retirement, for the run) against the exact
+    operator alone (`among` it), per set, and the most modes up to which the first was the
+    faster (gyro.questions.frequencies CERTIFIED_MODES); the same for mode k alone, and the
+    modes for which the first was not the faster there (none may be, for a rule by the number
+    of modes to hold); and the certificate's parts alone (`certificate_costs`: COUNT_COST,
+    OPERATOR_COST)."""
     P = joint(n, seed)
     chunk = 10_000
     parts = [P[s:s + chunk] for s in range(0, n, chunk)]
@@ -545,34 +558,83 @@ def random_speed(n: int, seed: int = 36) -> dict:
         if (lv.answers_question("frequencies") and lv.name != "linear_exact:reference"
                 and not lv.name.endswith("polyroots")):
             F.answer(TG, lv, P[:2], {})
-
-    def timed(fn):
-        t0 = time.perf_counter()
-        out = [fn(p) for p in parts]
-        return (time.perf_counter() - t0) / n, out
-
-    t_exact, _ = timed(lambda p: ladder.spectrum(TG, p, "default"))
+    exact = "linear_exact:default"
+    ks = range(1, 11)
+    runs = {"exact": lambda p: ladder.spectrum(TG, p, "default"),
+            "exact_selected": lambda p: select(TG, "frequencies", p, 1e-3, {}, among=[exact])}
+    for key, tol, opts in REQUESTS:
+        runs[key] = lambda p, tol=tol, opts=opts: select(TG, "frequencies", p, tol, opts)
+    for k in ks:
+        runs[f"certified_first_{k}"] = lambda p, k=k: _certified_first(p, list(range(1, k + 1)))
+        runs[f"certified_first_mode_{k}"] = lambda p, k=k: _certified_first(p, [k])
+    seconds = {key: 0.0 for key in runs}
+    used = {key: {} for key, _, _ in REQUESTS}
+    for p in parts:
+        for key, fn in runs.items():
+            t0 = time.perf_counter()
+            res = fn(p)
+            seconds[key] += time.perf_counter() - t0
+            if key in used:
+                for name, c in zip(*np.unique(res.level, return_counts=True)):
+                    used[key][str(name)] = used[key].get(str(name), 0) + int(c)
+    per = {key: t / n for key, t in seconds.items()}
+    t_exact = per["exact"]
     out = {"sets": n, "seed": seed, "exact_default_s_per_set": t_exact}
-    for key, tol, opts in (("all_1e-3", 1e-3, {}), ("modes_1_2_4_1e-3", 1e-3, {"modes": [1, 2, 4]}),
-                           ("modes_4_1e-3", 1e-3, {"modes": [4]}), ("all_1e-9", 1e-9, {})):
-        t, scenes_ = timed(lambda p: select(TG, "frequencies", p, tol, opts))
-        used = {}
-        for sc in scenes_:
-            for name, c in zip(*np.unique(sc.level, return_counts=True)):
-                used[str(name)] = used.get(str(name), 0) + int(c)
-        out[key] = {"s_per_set": t, "ratio_to_exact": t_exact / t, "levels": used}
-    # the certificate alone, on the formulas' answers of the first chunk
-    p = parts[0]
+    for key, _, _ in REQUESTS:
+        out[key] = {"s_per_set": per[key], "ratio_to_exact": t_exact / per[key], "levels": used[key]}
+    t_cf = [per[f"certified_first_{k}"] for k in ks]
+    faster = [bool(t < per["exact_selected"]) for t in t_cf]
+    t_one = [per[f"certified_first_mode_{k}"] for k in ks]
+    out["modes_1e-3"] = {"k": list(ks), "certified_first_s_per_set": t_cf,
+                         "exact_alone_s_per_set": per["exact_selected"], "certified_first_faster": faster,
+                         "CERTIFIED_MODES": (faster + [False]).index(False),
+                         "mode_k_alone_certified_first_s_per_set": t_one,
+                         "modes_alone_not_faster": [k for k, t in zip(ks, t_one) if not t < per["exact_selected"]]}
+    out["certificate"] = certificate_costs(parts[0], t_exact)
+    return out
+
+
+def _certified_first(p: np.ndarray, modes: list):
+    """The selector at 1e-3 for `modes` with the certificate's declared costs set to 0 and no
+    retirement: the certified levels tried before the exact operator, whatever their proof
+    costs."""
+    saved = F.OPERATOR_COST, F.COUNT_COST, F.CERTIFIED_MODES
+    F.OPERATOR_COST = F.COUNT_COST = 0.0
+    F.CERTIFIED_MODES = len(TG.meta["reduced"])
+    try:
+        return select(TG, "frequencies", p, 1e-3, {"modes": modes})
+    finally:
+        F.OPERATOR_COST, F.COUNT_COST, F.CERTIFIED_MODES = saved
+
+
+def certificate_costs(p: np.ndarray, t_exact: float) -> dict:
+    """What the frequencies' certificate costs on the sets p, on the formulas' answers with
+    a bound of 1e-3 (s per set): a count alone (the compiled inertia over the points of the
+    ten modes' intervals), the certificate of one, three and ten modes, and the rest of it
+    beside its counts (the equilibrium, the operator, the bookkeeping: one mode's certificate
+    less its three counts); and the same on the scale of the methods' COST (the default
+    method's COST over its time t_exact in this run), which is how the question declares
+    them (gyro.questions.frequencies COUNT_COST, OPERATOR_COST: the selector's order)."""
+    from gyro import methods
+    from gyro.equilibrium import equilibria, operators
+
     lv = hierarchy.get(TG, "formulas")
     ans = F.answer(TG, lv, p, {})
     b = np.full(ans.values.shape, 1e-3)
-    for key, idx in (("certificate_1_mode_s_per_set", [3]), ("certificate_10_modes_s_per_set", list(range(10)))):
-        t0 = time.perf_counter()
-        F.certify(TG, lv, p, ans, b, idx)
-        out[key] = (time.perf_counter() - t0) / p.shape[0]
-    t0 = time.perf_counter()
-    F.answer(TG, lv, p, {})
-    out["formulas_s_per_set"] = (time.perf_counter() - t0) / p.shape[0]
+    out = {}
+    for key, idx in (("1_mode", [3]), ("3_modes", [0, 1, 3]), ("10_modes", list(range(10)))):
+        out[f"certificate_{key}_s_per_set"] = per_set(lambda: F.certify(TG, lv, p, ans, b, idx), p.shape[0])
+    M, D, K = operators(TG, p, equilibria(TG, p)[0])
+    f = ans.values
+    W = np.concatenate([np.zeros((len(p), 1)), f / (1 + 1e-3), f / (1 - 1e-3)], axis=1)
+    out["count_s"] = per_set(lambda: F.counts_at(M, D, K, W), W.size)
+    out["rest_s_per_set"] = out["certificate_1_mode_s_per_set"] - 3 * out["count_s"]
+    for name in ("formulas", "decoupled", "linear_paper", "quartic"):
+        level = hierarchy.get(TG, name)
+        out[f"{name}_s_per_set"] = per_set(lambda: F.answer(TG, level, p, {}), p.shape[0])
+    scale = methods.get("default").COST / t_exact
+    out["scale_to_COST"] = scale
+    out["declare"] = {"COUNT_COST": out["count_s"] * scale, "OPERATOR_COST": out["rest_s_per_set"] * scale}
     return out
 
 

@@ -50,6 +50,8 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
     row = np.full(N, -1)
     trials, answers = [], {}
     pending = np.arange(N)
+    # what the certificates of the levels a set tries share (the exact operator: made once a set)
+    shared = q.certificate_data(model, P) if hasattr(q, "certificate_data") else None
     for lv in cands:
         if pending.size == 0:
             break
@@ -78,7 +80,8 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
         total = hierarchy.Bounds(B.apriori[sub], B.estimate, B.invalid[sub], B.answered, B.bad[sub]).total(ans.estimate)
         failed = ans.failed != ""
         if certifying:
-            total, edge = proven(q, model, lv, P[ks], ans, total, idx, tol, question)
+            total, edge = proven(q, model, lv, P[ks], ans, total, idx, tol, question,
+                                 None if shared is None else shared.take(ks))
         else:
             edge = q.edges(model, ans, total, idx, B.answered)
         worst = total[:, idx].max(axis=1) if idx else np.zeros(sub.size)
@@ -99,7 +102,7 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
                  time.perf_counter() - t0, answers, row)
 
 
-def proven(q, model, lv, P, ans, total, idx, tol, question: str = "frequencies"):
+def proven(q, model, lv, P, ans, total, idx, tol, question: str = "frequencies", data=None):
     """The bound a level's certificate proves per set and requested quantity, and per set
     the reason where it proves none: its own bound where that is within reach, else tol
     itself (the certificate proves an interval of any width: a cheap answer whose own bound
@@ -109,7 +112,8 @@ def proven(q, model, lv, P, ans, total, idx, tol, question: str = "frequencies")
     (the rounding of the inputs, u cos(phi) near the pole) separates that from the exact
     model: a proven c and an input term t make c + t + c t, so c is at most
     (tol - t)/(1 + t). inf where nothing is proven; the rank of each mode is proven with
-    it, so no neighbour's interval is an edge."""
+    it, so no neighbour's interval is an edge. `data`: what the certificates of these sets
+    share (the question's `certificate_data`, taken at their rows), or None."""
     spec = lv.evaluator.get("certify")
     t = np.zeros(total.shape)
     if isinstance(spec, dict) and spec.get("inputs"):
@@ -124,10 +128,11 @@ def proven(q, model, lv, P, ans, total, idx, tol, question: str = "frequencies")
     reason[short] = "certificate: the rounding of the inputs alone exceeds the tolerance"
     live = np.flatnonzero((ans.failed == "") & ~short)
     if live.size and idx:
-        reason[live] = q.certify(model, lv, P[live], ans.take(live), claim[live], idx)
+        part = (lambda rows: {}) if data is None else (lambda rows: {"data": data.take(rows)})  # noqa: E731
+        reason[live] = q.certify(model, lv, P[live], ans.take(live), claim[live], idx, **part(live))
         again = live[(reason[live] != "") & np.any(claim[live][:, idx] < room[live][:, idx], axis=1)]
         if again.size:
-            second = q.certify(model, lv, P[again], ans.take(again), room[again], idx)
+            second = q.certify(model, lv, P[again], ans.take(again), room[again], idx, **part(again))
             took = again[second == ""]
             claim[took], reason[took] = room[took], ""
     out = claim + t + claim * t

@@ -23,7 +23,9 @@ A question module has NAME (the command line's name) and:
   `certificate_cost(level, idx) -> s`: for a level whose evaluator says "certify", the
   proof of each set's answer within `bound` against the exact model ('' where proven, the
   reason otherwise) and its cost per set, which the selector adds to the level's in its
-  order (gyro.analyses.scene.proven, candidates).
+  order (gyro.analyses.scene.proven, candidates); optionally `certificate_data(model, P)`:
+  what the certificates of the levels a set tries share (made once per set), an object
+  with `take(rows)` whose view certify gets as `data=`.
 
 `names()` reads NAME from the sources (no NumPy); `get(name)` imports one.
 """

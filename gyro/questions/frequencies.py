@@ -232,21 +232,28 @@ def _say(out: np.ndarray, flags: np.ndarray, text) -> None:
         out[rows] = np.array([text(i) for i in range(flags.shape[1])], dtype=object)[j]
 
 
-# s per set on one core, on the scale of the methods' COST (linear_exact:default 3.6e-5 s):
-# a count (the compiled Bunch-Kaufman inertia, counts_at) and the rest of a certificate
-# (the equilibrium, the operator, the bookkeeping), from one run of
-# `python -m bench.levels --random-speed` (levels.json 'random_speed': one mode's certificate
-# 0.72x the default method's time, ten modes' 3.0x..4.2x). So the certificate leaves a cheap level
-# its advantage for one or two requested modes, and costs more than it for three and more
-COUNT_COST = 4.1e-6
-OPERATOR_COST = 8.7e-6
+# s per set on one core, on the scale of the methods' COST (linear_exact:default 3.6e-5 s): a
+# count (the compiled inertia, counts_at) and the rest of a certificate beside its counts (the
+# equilibrium, the operator, the count at 0, the bookkeeping), measured in one run of
+# `python -m bench.levels --random-speed 100000` (levels.json random_speed.certificate.declare)
+COUNT_COST = 1.7e-6
+OPERATOR_COST = 8.1e-6
+# The most requested modes for which the certified levels, tried before the exact operator,
+# answered faster than it alone in that run (random_speed.modes_1e-3: modes 1..k at 1e-3, each
+# set trying the levels in turn, a certificate for each; each mode alone was faster too).
+# Beyond, a level's proof costs its advantage: certificate_cost is infinite, and the exact
+# operator, the cheaper proven answer, is tried first (the cheap levels retired there).
+CERTIFIED_MODES = 2
 
 
 def certificate_cost(level, idx) -> float:
     """The certificate's seconds per set for the requested modes idx (0 for a level that
-    declares none): the operator, the count at 0 (K > 0) and two per requested mode."""
+    declares none): the rest of it and three counts for one mode, two more per mode; infinite
+    for more than CERTIFIED_MODES modes (retired: measured slower than the exact operator)."""
     if not level.evaluator.get("certify"):
         return 0.0
+    if len(idx) > CERTIFIED_MODES:
+        return float("inf")
     return OPERATOR_COST + COUNT_COST * (1 + 2 * len(idx))
 
 
@@ -285,13 +292,15 @@ def counts_below(M, D, K, w) -> np.ndarray:
 NOT_GYROSCOPIC = -2  # counts_at: M or K not symmetric, or D not skew, to the bit (no count)
 
 
-def counts_at(M, D, K, W) -> np.ndarray:
+def counts_at(M, D, K, W, rows=None) -> np.ndarray:
     """counts_below at the points W (sets, points) of each set: the compiled twin
     (gyro/questions/inertia.c: Bunch-Kaufman's LDL^H of the same scaled matrix, its inertia
     that of the blocks, proven by the factorization's backward error against the smallest
-    block over ||L^-1||_F^2) where a compiler is at hand, else LAPACK's eigenvalues in NumPy.
-    -> (sets, points), -1 where not proven, NOT_GYROSCOPIC for every point of a set whose
-    operator is not conservative gyroscopic (bearing damping)."""
+    block over ||L^-1||_F^2; in real arithmetic where a 2-colouring of the coordinates makes
+    the matrix real) where a compiler is at hand, else LAPACK's eigenvalues in NumPy.
+    `rows` (sets,): set k's operator is M[rows[k]] (no copies of a shared batch's); None:
+    M[k]. -> (sets, points), -1 where not proven, NOT_GYROSCOPIC for every point of a set
+    whose operator is not conservative gyroscopic (bearing damping)."""
     from gyro import cbackend
     from gyro.qep import gyroscopic
 
@@ -299,6 +308,8 @@ def counts_at(M, D, K, W) -> np.ndarray:
     try:
         fn = _inertia_kernel()
     except cbackend.CompilerUnavailable:
+        if rows is not None:
+            M, D, K = M[rows], D[rows], K[rows]
         c = np.empty(W.shape, int)
         for s in chunks(N, max(1, 8192 // max(Pn, 1))):  # bounded memory: a matrix per count
             rep = lambda X: np.repeat(X[s], Pn, axis=0)  # noqa: E731
@@ -307,17 +318,21 @@ def counts_at(M, D, K, W) -> np.ndarray:
         return c
     import ctypes
 
-    arrs = [np.ascontiguousarray(X, dtype=float) for X in (M, D, K, W)]
+    arrs = [np.ascontiguousarray(X, dtype=float) for X in (M, D, K)]
+    w = np.ascontiguousarray(W, dtype=float)
+    index = None if rows is None else np.ascontiguousarray(rows, dtype=np.int64)
     out = np.empty(W.shape)
     ptr = ctypes.POINTER(ctypes.c_double)
-    fn(ctypes.c_long(N), ctypes.c_long(M.shape[-1]), ctypes.c_long(Pn),
-       *[a.ctypes.data_as(ptr) for a in arrs + [out]])
+    fn(ctypes.c_long(N), ctypes.c_long(M.shape[-1]), ctypes.c_long(Pn), *[a.ctypes.data_as(ptr) for a in arrs],
+       None if index is None else index.ctypes.data_as(ctypes.POINTER(ctypes.c_long)),
+       w.ctypes.data_as(ptr), out.ctypes.data_as(ptr))
     c = out.astype(int)
     # the factorization's bound is the weaker near a frequency (1.4 % of the points at a
     # relative 1e-7 from one, where LAPACK's eigenvalues prove all): those again in NumPy
     k, p = np.nonzero((c == -1) & np.isfinite(W) & (W >= 0))
     if k.size:
-        c[k, p] = counts_below(M[k], D[k], K[k], W[k, p])
+        r = k if rows is None else np.asarray(rows)[k]
+        c[k, p] = counts_below(M[r], D[r], K[r], W[k, p])
     return c
 
 
@@ -334,40 +349,99 @@ def _inertia_kernel():
     return fn
 
 
-def certify(model, level, P, ans: Answer, bound: np.ndarray, idx) -> np.ndarray:
+class Exact:
+    """Per set of a batch, what a certificate needs of the exact model whatever the level:
+    the equilibrium, the operator M, D, K there, and the count at 0 (K positive definite),
+    made once per set for every certified level the set tries (the selector's batch:
+    `certificate_data`; a level's sets are `take(rows)`), and kept where made: a later
+    level's counts read them by row (counts_at's `rows`), not copied."""
+
+    def __init__(self, model, P, rows=None, store=None):
+        self.model, self.P = model, P
+        self.rows = np.arange(P.shape[0]) if rows is None else np.asarray(rows)
+        self.store = {"where": np.full(P.shape[0], -1)} if store is None else store
+
+    def take(self, rows) -> "Exact":
+        return Exact(self.model, self.P, self.rows[rows], self.store)
+
+    def get(self):
+        """(ok (sets,): an equilibrium found; M, D, K; at (ok sets,): the row of M, D, K of
+        each such set; zero (ok sets,): its count at 0) for this view's sets."""
+        st = self.store
+        todo = np.unique(self.rows[st["where"][self.rows] == -1])
+        if todo.size:
+            ok, M, D, K, zero = _exact(self.model, self.P[todo])
+            if "M" not in st:  # the first: kept as made
+                base = 0
+                st.update(M=M, D=D, K=K, zero=zero)
+            else:  # sets a cheaper level did not try (beyond its edges): appended
+                base = st["M"].shape[0]
+                for key, v in (("M", M), ("D", D), ("K", K), ("zero", zero)):
+                    st[key] = np.concatenate([st[key], v])
+            st["where"][todo] = -2  # tried: no equilibrium
+            st["where"][todo[ok]] = base + np.arange(int(ok.sum()))
+        where = st["where"][self.rows]
+        ok = where >= 0
+        at = where[ok]
+        if "M" not in st:  # no set asked yet
+            n = len(self.model.meta["reduced"])
+            return ok, np.zeros((0, n, n)), np.zeros((0, n, n)), np.zeros((0, n, n)), at, at
+        return ok, st["M"], st["D"], st["K"], at, st["zero"][at]
+
+
+def _exact(model, P):
+    """(ok, M, D, K of the sets with an equilibrium, their counts at 0) over the batch P."""
+    from gyro.equilibrium import equilibria, operators
+
+    qe, ok = equilibria(model, P)
+    n = len(model.meta["reduced"])
+    if not ok.any():
+        return ok, np.zeros((0, n, n)), np.zeros((0, n, n)), np.zeros((0, n, n)), np.zeros(0, int)
+    every = bool(ok.all())  # no copies of the batch where every set has its equilibrium
+    M, D, K = operators(model, P if every else P[ok], qe if every else qe[ok])
+    M, D, K = (np.ascontiguousarray(X, dtype=float) for X in (M, D, K))
+    zero = counts_at(M, D, K, np.zeros((M.shape[0], 1)))[:, 0]
+    return ok, M, D, K, zero
+
+
+def certificate_data(model, P) -> Exact:
+    """What the certificates of the levels a batch tries share (the selector's batch)."""
+    return Exact(model, P)
+
+
+def certify(model, level, P, ans: Answer, bound: np.ndarray, idx, data: Exact | None = None) -> np.ndarray:
     """'' per set where every requested mode j is proven to be the exact operator's j-th
     frequency within its bound b (|f - omega_j| <= b omega_j: omega_j in [f/(1+b),
     f/(1-b)]), the reason otherwise: counts_below at both ends of the interval prove that
     omega_j lies in it (at most j - 1 frequencies below its lower end, at least j below its
-    upper one), which proves its value and its rank together. Where the count cannot be
-    evaluated (no equilibrium, bearing damping, K not positive definite, a count not
-    resolved in double precision, b >= 1), the set is not answered by the level."""
-    from gyro.equilibrium import equilibria, operators
-
+    upper one), which proves its value and its rank together, with the count at 0 (K
+    positive definite). Where the count cannot be evaluated (no equilibrium, bearing
+    damping, K not positive definite, a count not resolved in double precision, b >= 1),
+    the set is not answered by the level. `data`: the exact operators of these sets (Exact,
+    shared with the other levels they try), made here where not given."""
     N = P.shape[0]
     out = np.full(N, "", object)
-    qe, ok = equilibria(model, P)
+    ok, M, D, K, at, zero = (data if data is not None else Exact(model, P)).get()
     out[~ok] = "certificate: no equilibrium to count the exact operator's frequencies at"
     live = np.flatnonzero(ok)
     if live.size == 0:
         return out
-    every = live.size == N  # no copies of the batch's operators where every set has its equilibrium
-    M, D, K = operators(model, P if every else P[live], qe if every else qe[live])
+    every = live.size == N
     f = ans.values if every else ans.values[live]
     b = bound if every else bound[live]
-    W = np.zeros((live.size, 1 + 2 * len(idx)))
+    W = np.zeros((live.size, 2 * len(idx)))
     with np.errstate(all="ignore"):
         for i, j in enumerate(idx):
             informative = np.isfinite(b[:, j]) & (b[:, j] < 1) & np.isfinite(f[:, j]) & (f[:, j] > 0)
-            W[:, 1 + 2 * i] = np.where(informative, f[:, j] / (1 + b[:, j]), -1.0)
-            W[:, 2 + 2 * i] = np.where(informative, f[:, j] / (1 - b[:, j]), -1.0)
-    c = counts_at(M, D, K, W)
+            W[:, 2 * i] = np.where(informative, f[:, j] / (1 + b[:, j]), -1.0)
+            W[:, 2 * i + 1] = np.where(informative, f[:, j] / (1 - b[:, j]), -1.0)
+    c = counts_at(M, D, K, W, at)
     c[W < 0] = -1
     reason = np.full(live.size, "", object)
-    reason[c[:, 0] == NOT_GYROSCOPIC] = "certificate: the operator is not conservative gyroscopic (damping): no count"
-    reason[(c[:, 0] != 0) & (reason == "")] = "certificate: K not proven positive definite (no count of the frequencies)"
+    reason[zero == NOT_GYROSCOPIC] = "certificate: the operator is not conservative gyroscopic (damping): no count"
+    reason[(zero != 0) & (reason == "")] = "certificate: K not proven positive definite (no count of the frequencies)"
     for i, j in enumerate(idx):
-        lo, hi = c[:, 1 + 2 * i], c[:, 2 + 2 * i]
+        lo, hi = c[:, 2 * i], c[:, 2 * i + 1]
         unproven = (lo < 0) | (hi < 0)
         wrong = ~unproven & ((lo > j) | (hi < j + 1))
         todo = reason == ""

@@ -194,3 +194,48 @@ def test_rounding_bound_of_a_margin():
     assert sp.simplify(rounding_scale(b**3 - a / 3, ps) - 8 * (sp.Abs(b)**3 + a / 3)) == 0
     with pytest.raises(Unsupported, match="Laurent polynomial"):
         rounding_scale(sp.sqrt(a) - 1, ps)
+
+
+DAMPED = '''"""A damped oscillator m x'' + c x' + k x = 0 whose stiffness may be negative, with two
+declared sets: c > 0 and k > 0 (Routh-Hurwitz for m p^2 + c p + k), and one with 1/c."""
+import sympy as sp
+
+from derive.model import Conditions, Model, Parameter
+
+PARAMETERS = [Parameter("m", "kg", 2.0, "mass"),
+              Parameter("c", "N s/m", 0.3, "damping", kind="nonnegative"),
+              Parameter("k", "N/m", 50.0, "stiffness", kind="real")]
+m, c, k = (p.symbol for p in PARAMETERS)
+x, x_d, x_dd = sp.symbols("x x_d x_dd")
+
+
+def build():
+    return Model(name="damped_conditions", title="Damped oscillator with conditions", source="textbook",
+                 module=__name__, parameters=PARAMETERS, coordinates=["x"], coordinate_units={"x": "m"},
+                 q=[x], qd=[x_d], qdd=[x_dd], lagrangian=m * x_d**2 / 2 - k * x**2 / 2,
+                 dissipation=c * x_d**2 / 2, symmetric_zero=["x"],
+                 conditions={"Routh-Hurwitz": Conditions([("c", c), ("k", k)]),
+                             "over c": Conditions([("k - 1/c", k - 1 / c)])})
+'''
+
+
+def test_a_damped_model_any_set_decides_and_a_margin_without_a_value_is_refused(tmp_path):
+    """A damped (not conservative) operator: every root must lie left of the axis. At the
+    defaults both sets hold: stable, roots -c/(2 m) +- i sqrt(k/m - c^2/(4 m^2)); with
+    k = -1 both fail and the root (-c + sqrt(c^2 - 4 m k))/(2 m) grows (1e-12: a 1x1
+    problem's roots); at c = 0 the margin k - 1/c has no value: one line, exit 2."""
+    path = tmp_path / "damped_conditions.py"
+    path.write_text(DAMPED)
+    rc, out, err = run_cli("stability", str(path), "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    assert d["verdict"] == "stable" and d["sufficient"] and list(d["conditions"]) == ["c", "k", "k - 1/c"]
+    w = math.sqrt(50 / 2 - 0.3**2 / 16)
+    assert np.allclose(sorted(d["eigenvalues"]), [[-0.075, -w], [-0.075, w]], rtol=1e-12)
+    rc, out, err = run_cli("stability", str(path), "--set", "k=-1", "--json")
+    d = json.loads(out)
+    assert rc == 0 and d["verdict"] == "unstable" and not d["sufficient"]
+    assert math.isclose(max(re for re, _ in d["eigenvalues"]), (-0.3 + math.sqrt(0.09 + 8)) / 4, rel_tol=1e-12)
+    rc, out, err = run_cli("stability", str(path), "--set", "c=0")
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "the margin k - 1/c of damped_conditions is not finite" in err and "inf" not in err.replace("finite", "")

@@ -76,6 +76,26 @@ def declared(model: Model) -> list[dict]:
     return sets
 
 
+def require(model: Model) -> None:
+    """What both commands need, or one line: declared conditions, and an operator about an
+    equilibrium (not about a stationary motion of momenta given as inputs)."""
+    declared(model)
+    if model.meta.get("momenta"):
+        raise ParameterError(f"{model.name}: its operator depends on the momenta {', '.join(model.meta['momenta'])} "
+                             "of a stationary motion; the conditions are read about an equilibrium")
+
+
+def finite_margins(model: Model, a: dict, where=lambda k: "") -> None:
+    """Every margin and bound finite where there is an equilibrium (a parameter at zero in
+    a margin's denominator gives none): otherwise one line naming the margin, never a
+    verdict read from NaN."""
+    bad = a["ok"][:, None] & ~(np.isfinite(a["margins"]) & np.isfinite(a["bounds"]))
+    if bad.any():
+        k, j = np.argwhere(bad)[0]
+        raise ParameterError(f"the margin {labels(model)[j]} of {model.name} is not finite at these parameters "
+                             f"(a parameter at zero in its denominator?){where(k)}")
+
+
 def labels(model: Model) -> list[str]:
     return [label for s in declared(model) for label in s["labels"]]
 
@@ -283,6 +303,7 @@ def stability(model: Model, values: dict, options: dict | None = None):
     a = analyse(model, P, options)
     if not a["ok"][0]:
         raise ParameterError(no_equilibrium(model, P[0]))
+    finite_margins(model, a)
     r = _report(model, values, a, options)
     every = labels(model)
     shown = [every.index(k) for k in r["shown"]]
@@ -349,6 +370,7 @@ def condition_map(model: Model, sets: dict, xaxis, yaxis, options: dict | None =
         k = int(np.argmin(a["ok"]))
         xv, yv = x[k % nx], y[k // nx]
         raise ParameterError(f"{no_equilibrium(model, P[k])} (at {xn} = {xv:.6g}, {yn} = {yv:.6g})")
+    finite_margins(model, a, lambda k: f" (at {xn} = {x[k % nx]:.6g}, {yn} = {y[k // nx]:.6g})")
     label = a["verdict"].label
     values = np.select([label == "boundary", label == "marginal", a["sufficient"], label == "stable"],
                        [BOUNDARY, MARGINAL, 2, 1], 0).reshape(ny, nx)

@@ -41,7 +41,7 @@ def run(args) -> int:
     from gyro.models import load
 
     model = load(args.model)
-    conditions.declared(model)
+    conditions.require(model)
     options = {"orbit": True} if args.orbit else {}
     conditions.check_options(model, options)
     xaxis, yaxis = conditions.parse_axis(model, "--x", args.x), conditions.parse_axis(model, "--y", args.y)

@@ -37,7 +37,7 @@ def run(args) -> int:
     from gyro.models import load
 
     model = load(args.model)
-    conditions.declared(model)
+    conditions.require(model)
     options = {"orbit": True} if args.orbit else {}
     values = conditions.parameters(model, parse_sets(args.set), options)
     res = conditions.stability(model, values, options)

@@ -187,8 +187,7 @@ def analyse(model: Model, P: np.ndarray, options: dict | None = None) -> dict:
         radius = np.full((n, m2), np.inf)
         if ok.any():
             eig[ok], radius[ok] = qep.eigen_radii(A[ok], Mc[ok])
-    in_force = _hook(model, "conditions_in_force", None)
-    alternatives = (in_force or (lambda *a: every_set(model, *a[1:])))(model, P, marg, bnd, options)
+    alternatives = _hook(model, "conditions_in_force", every_set)(model, P, marg, bnd, options)
     held, decided_all = np.zeros(n, bool), np.ones(n, bool)
     applies, rounded = np.zeros(n, bool), np.zeros(n, bool)
     why = np.full(n, None, dtype=object)

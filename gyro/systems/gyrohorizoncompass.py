@@ -237,7 +237,7 @@ def conditions_in_force(m, P: np.ndarray, marg: np.ndarray, bnd: np.ndarray, opt
     effect, V only semidefinite) is no 'stable'."""
     n = P.shape[0]
     _, margins, tc = _closed_form(m, P)
-    orbit = np.broadcast_to(np.asarray(options.get("orbit", False) or options.get("on_orbit", False), bool), (n,))
+    orbit = np.broadcast_to(np.asarray(options.get("orbit", False), bool) | bool(options.get("on_orbit")), (n,))
     syl, c36, c43 = marg[:, SYL], marg[:, S36], marg[:, S43]
     b_syl, b36, b43 = bnd[:, SYL], bnd[:, S36], bnd[:, S43]
     # 3: (3.6) with eta != 0, where (3.2) makes lambda = 1 + chi exact at the decimal inputs,

@@ -34,18 +34,16 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from gyro.equilibrium import operators
-from gyro.errors import finite_number, grid_axis
+from gyro.errors import finite_number
 from gyro.kernels import function
 from gyro.models import ParameterError, load
 from gyro import ode, qep
 from gyro.qep import companion_matrix
-from gyro.results import verdict
 
 MODEL = "gyrohorizoncompass"
 NAMES = ("A", "B", "C", "J", "L", "I", "nu", "zeta", "eta", "lambda")
 DERIVED = ("theta", "chi")  # map axes besides the parameters
 U = qep.UNIT_ROUNDOFF  # the unit roundoff of double precision
-BOUNDARY, MARGINAL = -1, -2  # condition_map's values besides 2, 1, 0
 LAMBDA_TOL = 1e-12  # lambda = 1 + chi to this relative tolerance when eta != 0
 
 C36 = ("(3.6) 1 + theta", "(3.6) 1/3 - theta", "(3.6) 1 + chi", "(3.6) 1/3 - chi",
@@ -359,13 +357,6 @@ def energy_bound(values: dict) -> float:
 
 
 # ------------------------------------------------------------------ maps
-
-
-def parse_axis(flag: str, text: str) -> tuple[str, float, float, int]:
-    """NAME=LO:HI:N over a parameter (its declared name or another taken for it) or theta,
-    chi -> (this module's name, lo, hi, n)."""
-    name, lo, hi, n = grid_axis(flag, text, NAMES + DERIVED + tuple(model().aliases.values()), 1000)
-    return cli_name(name), lo, hi, n
 
 
 def condition_map(base: dict, xaxis, yaxis, orbit: bool = False, lambda_follows: bool = True):

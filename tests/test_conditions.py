@@ -239,3 +239,8 @@ def test_a_damped_model_any_set_decides_and_a_margin_without_a_value_is_refused(
     rc, out, err = run_cli("stability", str(path), "--set", "c=0")
     assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
     assert "the margin k - 1/c of damped_conditions is not finite" in err and "inf" not in err.replace("finite", "")
+    # a declared system that is not there: one line, no traceback
+    path.write_text(DAMPED.replace('symmetric_zero=["x"],', 'symmetric_zero=["x"], system="gyro.systems.nosuch",'))
+    rc, out, err = run_cli("stability", str(path))
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert "its declared system 'gyro.systems.nosuch' cannot be imported" in err

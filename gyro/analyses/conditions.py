@@ -103,7 +103,12 @@ def labels(model: Model) -> list[str]:
 def system(model: Model):
     """The model's own runtime module (metadata `system`), or None."""
     name = model.meta.get("system")
-    return importlib.import_module(name) if name else None
+    if not name:
+        return None
+    try:
+        return importlib.import_module(name)
+    except ImportError as exc:
+        raise ParameterError(f"{model.name}: its declared system {name!r} cannot be imported ({exc})") from None
 
 
 def _hook(model: Model, name: str, default=None):

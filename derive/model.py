@@ -207,6 +207,20 @@ def runtime_module(model, name: str) -> str:
     return name
 
 
+@dataclass(frozen=True)
+class Conditions:
+    """A named set of sufficient conditions for the stability of the model's equilibrium
+    (Model.conditions): it holds where every margin is > 0. `margins` is a list of
+    (label, expression in the parameters), each label one line that names the margin (the
+    labels of all a model's sets are distinct); `doc` says where the set comes from and what
+    it assumes. The derivation emits the margins (`conditions`) and a rounding bound of each
+    (`conditions_rounding`, derive/outputs/conditions.py); `gyro stability` and `gyro map`
+    read the set against the spectrum of the linearisation (gyro/analyses/conditions.py)."""
+
+    margins: list
+    doc: str = ""
+
+
 @dataclass
 class Model:
     """A mechanical system as data: what the generic pipeline needs to derive and emit it."""
@@ -284,6 +298,14 @@ class Model:
     # (name -> (unit, default, description)) are taken as --set NAME=VALUE, a note on the
     # coordinates they leave out ("psi(0) = phi(0) = 0"), which `gyro params` prints with them}
     simulate: dict = field(default_factory=dict)
+    # named sets of sufficient stability conditions: name -> Conditions (each holds where
+    # every margin > 0; derive/outputs/conditions.py emits the margins and their rounding
+    # bounds); `gyro stability` and `gyro map` need them
+    conditions: dict = field(default_factory=dict)
+    # the runtime module (dotted name, gyro.systems.<system>) with what only this system has:
+    # the hooks the generic analyses call (which condition applies where, derived map axes,
+    # options; gyro/analyses/conditions.py lists them); None: the generic analyses alone
+    system: str | None = None
     # names a user types for parameters whose symbol the emitted code cannot carry (the
     # paper's lambda is `lam`, M_motor `Mmotor`): {name typed: parameter's name}; every
     # command and the API take either (gyro.models.Model.parameters)

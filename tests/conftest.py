@@ -29,7 +29,7 @@ TIERS = {
     "properties": ("test_properties",),
     "cli": ("test_cli", "test_gimbal_simulate", "test_readme", "test_sweep", "test_wheel", "test_ghc_cli", "test_fuzz", "test_robustness",
             "test_tolerance", "test_executor", "test_motion_generic", "test_forced_generic", "test_precession_cli", "test_forced",
-            "test_unbalance_lagrangian", "test_campbell_stability", "test_param_names"),
+            "test_unbalance_lagrangian", "test_campbell_stability", "test_param_names", "test_conditions"),
 }
 _TIER_OF = {f: tier for tier, files in TIERS.items() for f in files}
 

@@ -225,11 +225,19 @@ def test_eta_0_admits_any_lambda():
     assert d["params"]["lambda"] == 1.3 and math.isclose(d["equilibrium"]["epsilon0"], math.acos(1.3 * 0.5))
 
 
-def test_unknown_model_exits_2():
+def test_the_declared_labels_are_the_ones_the_hooks_slice():
+    from gyro.analyses.conditions import labels
+
+    every = labels(ghc.model())
+    assert (tuple(every[ghc.SYL]), tuple(every[ghc.S36]), tuple(every[ghc.S43])) == (ghc.SYLVESTER, ghc.C36, ghc.C43)
+
+
+def test_a_model_without_conditions_exits_2():
     for cmd in ("stability", "map"):
         extra = [] if cmd == "stability" else ["--x", "zeta=0:1:3", "--y", "eta=0:1:3", "--out", "x.png"]
-        rc, _, err = gyro(cmd, "torsion_gyrocompass", *extra)
-        assert rc == 2 and "gyrohorizoncompass" in err
+        rc, out, err = gyro(cmd, "torsion_gyrocompass", *extra)
+        assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
+        assert "torsion_gyrocompass declares no conditions (Model.conditions" in err
 
 
 # --------------------------------------------------------------------------- gyro map

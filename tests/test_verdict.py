@@ -40,13 +40,18 @@ def _exact_margins(v: dict):
     """The emitted margins at 40 digits from the exact decimal inputs."""
     with mpmath.workdps(40):
         p = [mpmath.mpf(v[k].numerator) / v[k].denominator for k in NAMES]
-        return [np.array([float(x) for x in out]) for out in ghc.model().mpmath.stability_conditions(p)]
+        return _split(np.array([float(x) for x in ghc.model().mpmath.conditions(p)]))
+
+
+def _split(x):
+    """The declared margins (`conditions`) as [Sylvester minors, (3.6), (4.3)]."""
+    return [x[ghc.SYL], x[ghc.S36], x[ghc.S43]]
 
 
 def _margins(v: dict):
     P = ghc.model().vector(_floats(v))[None]
     m = ghc.model().numpy
-    return [np.ravel(x) for x in m.stability_conditions(P)], [U * np.ravel(x) for x in m.condition_rounding(P)]
+    return _split(np.ravel(m.conditions(P))), _split(U * np.ravel(m.conditions_rounding(P)))
 
 
 # the boundaries of (3.6) (group 1) and (4.3) (group 2), each placed exactly: (set, group, row)

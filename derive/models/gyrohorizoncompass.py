@@ -37,12 +37,13 @@ parameter symbol is `lam`, and the runtime maps the name `lambda` to it):
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import sympy as sp
 
 from derive import mechanics as mech
-from derive.model import Parameter
+from derive.model import Conditions, Parameter
 
 NAME = "gyrohorizoncompass"
 TITLE = "Gyrohorizoncompass in a Newtonian field of gravitation"
@@ -222,6 +223,7 @@ EQUILIBRIUM = {alpha: 0, beta: 0, gamma: 0}
 REST = {v: 0 for v in qd}
 
 
+@functools.lru_cache(maxsize=None)
 def hessians(at_eps=None):
     """B1 and C1 of (3.5): the Hessians of E in the rates and in the angles at the relative
     equilibrium (3.1) (epsilon = at_eps, default epsilon0), x = (alpha, beta, gamma,
@@ -276,31 +278,6 @@ def sylvester_minors(C1):
     return [M[:k, :k].det() for k in range(1, 5)]
 
 
-def rounding_scale(margin):
-    """k * sum |t| over the terms t of a margin expanded as a Laurent polynomial in the
-    parameters, k = 2 d + N (d the largest number of factors in a term, N the number of
-    terms): times the unit roundoff u it bounds, to first order in u, how far the margin
-    computed in floating point from inputs rounded to double can lie from its exact value
-    at the given decimal inputs (docs/gyrohorizoncompass.md, "Boundaries"). Each term
-    t = c p1^k1 ... carries at most d input roundings (1 + delta_i, |delta_i| <= u, one per
-    factor) and d - 1 product roundings; a sum of N terms adds at most N - 1 more. Every
-    parameter is positive except eta, which must occur to even powers only, so |t| is the
-    term with |c| for c and needs no Abs."""
-    terms = sp.Add.make_args(sp.expand(margin))
-    degree, total = 0, sp.Integer(0)
-    for t in terms:
-        c, mono = t.as_coeff_Mul()
-        powers = {} if mono == 1 else mono.as_powers_dict()
-        for base, k in powers.items():
-            if not (base.is_Symbol and k.is_Integer and base in P.values()):
-                raise ValueError(f"rounding_scale: {t} is not a monomial in the parameters")
-            if base == eta and k % 2:
-                raise ValueError(f"rounding_scale: odd power of eta in {t}")
-        degree = max(degree, sum(abs(int(k)) for k in powers.values()))
-        total += abs(c) * mono
-    return (2 * degree + len(terms)) * total
-
-
 # ----------------------------------------------------------------------------- quantities
 
 
@@ -328,21 +305,34 @@ def quantities():
                      "(3.5): B1 and C1, the Hessians of V = E - E0 in the rates and in "
                      "x = (alpha, beta, gamma, epsilon - epsilon0) at the relative equilibrium "
                      "(derived, for any lambda)."),
-        "stability_conditions": (["params"],
-                                 [("sylvester", sp.Matrix(sylvester_minors(C1))),
-                                  ("printed_36", sp.Matrix(conditions_36())),
-                                  ("satellite_43", sp.Matrix(conditions_43()))],
-                                 "Margins (> 0 when the condition holds): the leading minors of C1 "
-                                 "in the order alpha, gamma, beta, epsilon; the conditions (3.6) as "
-                                 "printed (zeta for xi); the satellite conditions (4.3) with "
-                                 "chi < lambda/4 (zeta = nu, eta = 0)."),
-        "condition_rounding": (["params"],
-                               [("sylvester", sp.Matrix([rounding_scale(m) for m in sylvester_minors(C1)])),
-                                ("printed_36", sp.Matrix([rounding_scale(m) for m in conditions_36()])),
-                                ("satellite_43", sp.Matrix([rounding_scale(m) for m in conditions_43()]))],
-                               "Rounding bounds of the margins of `stability_conditions`, over the "
-                               "unit roundoff: u times each bounds how far the computed margin can "
-                               "lie from the exact one at the decimal inputs (first order in u)."),
+    }
+
+
+# the labels of the margins, as `gyro stability` prints them
+SYLVESTER_LABELS = ("C1 minor 1 (alpha)", "C1 minor 2 (alpha, gamma)", "C1 minor 3 (alpha, gamma, beta)",
+                    "C1 minor 4 (all)")
+LABELS_36 = ("(3.6) 1 + theta", "(3.6) 1/3 - theta", "(3.6) 1 + chi", "(3.6) 1/3 - chi",
+             "(3.6) (1 - 3 theta) nu^2 - zeta^2 - eta^2", "(3.6) (1 - 3 chi) nu^2 - eta^2")
+LABELS_43 = ("(4.3) lambda + theta - chi", "(4.3) lambda/4 - chi", "(4.3) -theta")
+
+
+def conditions():
+    """The sufficient conditions of sections 3 and 4 (Model.conditions), emitted with their
+    rounding bounds as `conditions` and `conditions_rounding` (derive/outputs/conditions.py):
+    C1 > 0 by Sylvester's criterion (margins 0-3), (3.6) (4-9) and (4.3) (10-12). Which
+    applies where (the orbit, lambda = 1 + chi) is the runtime's gyro.systems.gyrohorizoncompass."""
+    _, C1 = hessians()
+    return {
+        "C1 > 0": Conditions(list(zip(SYLVESTER_LABELS, sylvester_minors(C1))),
+                             "Sylvester's criterion on C1 of (3.5), the Hessian of V = E - E0 in the angles: "
+                             "its leading minors in the order alpha, gamma, beta, epsilon (V positive "
+                             "definite: Lyapunov stability of (3.1), any lambda)"),
+        "(3.6)": Conditions(list(zip(LABELS_36, conditions_36())),
+                            "(3.6) as printed (zeta for xi): C1 > 0 where lambda = 1 + chi (3.2), with "
+                            "zeta != 0 and epsilon0 != 0"),
+        "(4.3)": Conditions(list(zip(LABELS_43, conditions_43())),
+                            "(4.3) on a circular orbit (zeta = nu, eta = 0, lambda free), read "
+                            "chi < lambda/4"),
     }
 
 
@@ -394,6 +384,8 @@ def build():
                            "cvodes-adams, projected (onto E = E(0))"},
         levels=levels(),
         aliases=CLI_NAMES,
+        conditions=conditions(),
+        system="gyro.systems.gyrohorizoncompass",
         # the start of the runtime's Newton: (3.1) itself (from zero it found the other
         # relative equilibrium, epsilon = 0 with beta = 1.1e-3 at the Earth set, unstable)
         equilibrium_approx={"alpha": sp.Integer(0), "beta": sp.Integer(0), "gamma": sp.Integer(0),

@@ -10,7 +10,8 @@ One module per kind of result; every name is importable from `gyro.results`.
 - `sweep`: `FrequencySweep` (frequencies against any one parameter);
 - `trajectory`: `Trajectory` (the gimbal's motion: closed form or an integrator), `CoordinateMotion`
   (any model's motion from its reference, gyro/analyses/motion.py);
-- `gyrohorizoncompass`: `EquilibriumStability`, `ConditionMap`, `AngleTrajectory`;
+- `gyrohorizoncompass`: `EquilibriumStability`, `ConditionMap` (any model's declared conditions
+  against its spectrum), `AngleTrajectory`;
 - `verdict`: `Verdict`, the one verdict type (stable, marginal, unstable, boundary,
   unknown, failed, each with its reason) and the two tests every analysis reads it through;
 - `sensitivity`: `Sensitivities` (d omega / d p of every frequency and parameter);

@@ -11,20 +11,19 @@ from gyro.results._io import Result, _edges, _more_rows, _pyplot, _shown_rows, s
 
 @dataclass
 class EquilibriumStability(Result):
-    """The relative equilibrium of one parameter set: its conditions (margins, > 0 when
-    satisfied), whether the sufficient one holds, and the spectrum of the linearisation."""
+    """The equilibrium of one parameter set: its conditions (margins, > 0 when satisfied),
+    whether the sufficient one holds, and the spectrum of the linearisation (any model that
+    declares conditions: gyro/analyses/conditions.py)."""
 
     model: str
     title: str
     params: dict  # the declared names
     equilibrium: dict
-    theta: float
-    chi: float
-    conditions: dict  # name -> margin
-    sufficient: bool
-    orbit: bool
-    eigenvalues: np.ndarray  # (2n, 2): re, im
-    spectrally_stable: bool
+    conditions: dict = field(default_factory=dict)  # name -> margin
+    sufficient: bool = False
+    orbit: bool = False
+    eigenvalues: np.ndarray | None = None  # (2n, 2): re, im
+    spectrally_stable: bool = False
     verdict: str = "stable"  # gyro.results.verdict.LABELS
     boundary_reason: str | None = None  # one line where the verdict is 'boundary' (or 'marginal')
     margin_bounds: dict = field(default_factory=dict)  # name -> rounding bound of the margin
@@ -32,6 +31,12 @@ class EquilibriumStability(Result):
     # {another name: the declared one} (lambda for lam): the JSON's params carry both, as
     # they carried lambda before the commands printed the declared name
     aliases: dict = field(default_factory=dict)
+    # what the model's system adds: JSON keys after `equilibrium` (the gyrohorizoncompass's
+    # theta and chi), the lines the table prints after the parameters (the equilibrium and
+    # those), and the name of the sufficient condition in force
+    extra: dict = field(default_factory=dict)
+    lines: list = field(default_factory=list)
+    condition: str = ""
 
     @property
     def boundary(self) -> bool:
@@ -42,7 +47,7 @@ class EquilibriumStability(Result):
         """The `gyro stability --json` document (its keys are the contract)."""
         params = dict(self.params) | {a: self.params[n] for a, n in self.aliases.items() if n in self.params}
         return {"model": self.model, "params": params, "equilibrium": dict(self.equilibrium),
-                "theta": float(self.theta), "chi": float(self.chi),
+                **{k: float(v) for k, v in self.extra.items()},
                 "conditions": {k: float(v) for k, v in self.conditions.items()},
                 "sufficient": bool(self.sufficient),
                 "eigenvalues": [[float(a), float(b)] for a, b in np.asarray(self.eigenvalues)],
@@ -56,12 +61,9 @@ class EquilibriumStability(Result):
         return self.spectrally_stable and not self.sufficient and not self.boundary
 
     def table(self) -> str:
-        which = "(4.3)" if self.orbit else "(3.6)"
         lines = [f"{self.title} ({self.model})",
                  "parameters: " + ", ".join(f"{k} = {v:.6g}" for k, v in self.params.items()),
-                 "relative equilibrium (3.1): alpha = beta = gamma = 0, "
-                 f"epsilon0 = {self.equilibrium['epsilon0']:.9g} rad",
-                 f"theta = (C - A)/I = {self.theta:.6g}, chi = (C - B)/I = {self.chi:.6g}",
+                 *self.lines,
                  f"{'condition (margin > 0 when it holds)':<48} {'margin':>14}"]
         for k, v in self.conditions.items():
             b = self.margin_bounds.get(k, 0.0)
@@ -78,7 +80,7 @@ class EquilibriumStability(Result):
         verdict = ("stable: the sufficient condition holds" if self.sufficient else
                    "spectrally stable outside the sufficient condition (gyroscopic stabilisation)"
                    if self.spectrally_stable else "unstable")
-        lines.append(f"sufficient {which}: {'yes' if self.sufficient else 'no'}; "
+        lines.append(f"sufficient {self.condition}: {'yes' if self.sufficient else 'no'}; "
                      f"spectrally stable: {'yes' if self.spectrally_stable else 'no'}; {verdict}")
         return "\n".join(lines)
 
@@ -92,8 +94,8 @@ class EquilibriumStability(Result):
 
 @dataclass
 class ConditionMap(Result):
-    """Over a grid of two axes (arrays (y, x)): 2 where the sufficient condition ((3.6), or
-    (4.3) on the orbit) holds, 1 where the linearisation is spectrally stable outside it
+    """Over a grid of two axes (arrays (y, x)): 2 where the sufficient condition (the model's
+    declared one, gyro/analyses/conditions.py) holds, 1 where the linearisation is spectrally stable outside it
     (gyroscopic stabilisation), 0 where it is unstable."""
 
     model: str
@@ -108,6 +110,7 @@ class ConditionMap(Result):
     base: dict = field(default_factory=dict)  # the other parameters (declared names)
     boundary: np.ndarray | None = None  # (y, x) bool: rounding could change the verdict
     reasons: np.ndarray | None = None  # (y, x) object: why a point is a boundary (None elsewhere)
+    condition: str = ""  # the sufficient condition's name ("(3.6)", "(4.3)" the gyrohorizoncompass's)
 
     KIND = ("2: {c} holds, 1: spectrally stable outside {c}, 0: unstable, -1: boundary (rounding "
             "could change the verdict), -2: marginal (an exact zero root)")
@@ -120,7 +123,7 @@ class ConditionMap(Result):
 
     @property
     def kind(self) -> str:
-        return self.KIND.format(c="(4.3)" if self.orbit else "(3.6)")
+        return self.KIND.format(c=self.condition)
 
     def counts(self) -> dict:
         """Points per class; a boundary point counts as none of the others (never stable,
@@ -141,7 +144,7 @@ class ConditionMap(Result):
 
     def summary(self, out) -> str:
         c = self.counts()
-        which = "(4.3)" if self.orbit else "(3.6)"
+        which = self.condition
         extra = f", {c['marginal']} marginal" if "marginal" in c else ""
         return (f"gyro: wrote {out} ({self.values.size} points: {c['sufficient']} where {which} holds, "
                 f"{c['gyroscopic']} spectrally stable outside it, {c['unstable']} unstable, "
@@ -159,7 +162,7 @@ class ConditionMap(Result):
         plt = _pyplot()
         from matplotlib.colors import ListedColormap
 
-        which = "(4.3)" if self.orbit else "(3.6)"
+        which = self.condition
         colors = ["#7a6fb0", "#222222", "#f2b8b0", "#f3e3a1", "#cfe8cf"]  # codes -2 .. 2
         names = {2: f"{which} holds", 1: f"spectrally stable outside {which} (gyroscopic stabilisation)",
                  0: "unstable", -1: "boundary: rounding could change the verdict",

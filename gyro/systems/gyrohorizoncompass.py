@@ -4,8 +4,11 @@ linearisation, maps of the three regions, and motions by integrating the emitted
 
 Everything numerical comes from generated/gyrohorizoncompass/: the equilibrium epsilon0 and
 its existence margins (`relative_equilibrium`), B1 and C1 (`lyapunov`), the margins of the
-conditions (`stability_conditions`), the operator M, D, K (`operator`), E (`first_integral`),
-and the equations of motion (`mass_matrix`, `forcing`).
+declared conditions (`conditions`: C1 > 0, (3.6), (4.3)), the operator M, D, K (`operator`),
+E (`first_integral`), and the equations of motion (`mass_matrix`, `forcing`). `gyro stability`
+and `gyro map` are the generic gyro.analyses.conditions, which reaches this module through
+the model's declaration `system` for what only this system has (the hooks below: which
+condition applies where, theta and chi as axes, --orbit, lambda following 1 + chi, (3.1)).
 
 The spectrum: the eigenvalues of the companion matrix [[0, I], [-M^-1 K, -M^-1 D]] of the
 emitted operator at (0, 0, 0, epsilon0) (LAPACK, balanced; gyro.qep.companion_matrix). The
@@ -13,7 +16,7 @@ ladder's default method assumes gyroscopic blocks with K > 0, which fails exactl
 module looks (gyroscopic stabilisation, K indefinite), so the companion eigensolve is used
 throughout. Each eigenvalue carries an error radius (`gyro.qep.eigen_radii`: its condition number
 times a bound on the rounding of the companion matrix), and each condition's margin a
-rounding bound (the emitted `condition_rounding`); the verdicts are read through
+rounding bound (the emitted `conditions_rounding`); the verdicts are read through
 gyro.results.verdict: 'unstable' where a root's disk lies right of the axis, 'boundary'
 where two disks overlap or a margin lies within its bound of zero (rounding could change
 the answer), 'stable' otherwise (docs/gyrohorizoncompass.md, "Boundaries").
@@ -31,18 +34,16 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from gyro.equilibrium import operators
-from gyro.errors import finite_number, grid_axis
+from gyro.errors import finite_number
 from gyro.kernels import function
 from gyro.models import ParameterError, load
 from gyro import ode, qep
 from gyro.qep import companion_matrix
-from gyro.results import verdict
 
 MODEL = "gyrohorizoncompass"
 NAMES = ("A", "B", "C", "J", "L", "I", "nu", "zeta", "eta", "lambda")
 DERIVED = ("theta", "chi")  # map axes besides the parameters
 U = qep.UNIT_ROUNDOFF  # the unit roundoff of double precision
-BOUNDARY, MARGINAL = -1, -2  # condition_map's values besides 2, 1, 0
 LAMBDA_TOL = 1e-12  # lambda = 1 + chi to this relative tolerance when eta != 0
 
 C36 = ("(3.6) 1 + theta", "(3.6) 1/3 - theta", "(3.6) 1 + chi", "(3.6) 1/3 - chi",
@@ -145,142 +146,200 @@ def on_orbit(values: dict) -> bool:
     return values["zeta"] == values["nu"] and values["eta"] == 0
 
 
+def _closed_form(m, P: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(epsilon0 (sets,), the existence margins (sets, 2), theta and chi (sets, 2)) of (3.1)-(3.2)."""
+    n = P.shape[0]
+    with np.errstate(all="ignore"):
+        eps0, margins, tc = (np.asarray(x).reshape(n, -1) for x in function(m, "relative_equilibrium")(P))
+    return eps0[:, 0], margins, tc
+
+
+def _exact(P: np.ndarray, tc: np.ndarray) -> np.ndarray:
+    """lambda = 1 + chi to LAMBDA_TOL: the printed rows of (3.6) assume it."""
+    return np.abs(P[:, 9] - (1 + tc[:, 1])) <= LAMBDA_TOL * np.maximum(1.0, np.abs(1 + tc[:, 1]))
+
+
 def analyse(P: np.ndarray, orbit: np.ndarray | bool = False) -> dict:
     """Batch P (sets, 10) of model vectors: epsilon0, theta, chi, the margins, `sufficient`,
-    the eigenvalues (sets, 8), `spectrally_stable`, B1, C1 and the residual at (3.1).
+    the eigenvalues (sets, 8), `spectrally_stable`, B1, C1 and the residual at (3.1): the
+    generic analysis of the declared conditions (gyro/analyses/conditions.py) through this
+    module's hooks below, with what only this system has.
 
     `sufficient`: C1 > 0 by the paper's own conditions: (4.3) on the orbit (`orbit`), (3.6)
     where lambda = 1 + chi, and where lambda != 1 + chi (eta = 0 off the orbit, where the
     printed rows are not C1's minors) the Sylvester minors of C1 they stand for."""
+    from gyro.analyses import conditions
+
     m = model()
     P = np.atleast_2d(np.asarray(P, float))
     n = P.shape[0]
+    a = conditions.analyse(m, P, {"orbit": orbit})
+    eps0, margins, tc = _closed_form(m, P)
     with np.errstate(all="ignore"):
-        eps0, margins, tc = (np.asarray(x).reshape(n, -1) for x in function(m, "relative_equilibrium")(P))
-        syl, c36, c43 = (np.asarray(x).reshape(n, -1) for x in function(m, "stability_conditions")(P))
         B1, C1 = (np.asarray(x).reshape(n, 4, 4) for x in function(m, "lyapunov")(P))
-        qe = np.zeros((n, 4))
-        qe[:, 3] = eps0[:, 0]
-        resid = np.asarray(function(m, "equilibrium_residual")(P, qe)[0]).reshape(n, -1)
-        M, D, K = operators(m, P, qe)
-        ok = np.isfinite(eps0[:, 0])
-        Mc = np.where(ok[:, None, None] & np.all(np.isfinite(M), axis=(1, 2))[:, None, None], M, np.eye(4))
-        A = companion_matrix(Mc, D, K)
-        ok &= np.all(np.isfinite(A), axis=(1, 2))
-        eig = np.full((n, 8), np.nan + 0j)
-        radius = np.full((n, 8), np.inf)
-        eig[ok], radius[ok] = qep.eigen_radii(A[ok], Mc[ok])
-        bounds = [U * np.asarray(x).reshape(n, -1) for x in function(m, "condition_rounding")(P)]
-    lam = P[:, 9]
-    exact = np.abs(lam - (1 + tc[:, 1])) <= LAMBDA_TOL * np.maximum(1.0, np.abs(1 + tc[:, 1]))
-    orbit = np.broadcast_to(np.asarray(orbit, bool), (n,))
-    # the sufficient condition in force at each set, its margins and their rounding bounds
+        resid = np.asarray(function(m, "equilibrium_residual")(P, a["qe"])[0]).reshape(n, -1)
+    marg, bnd = a["margins"], a["bounds"]
+    return {"epsilon0": eps0, "exists": margins[:, 0], "theta": tc[:, 0], "chi": tc[:, 1],
+            "lambda_is_1_chi": _exact(P, tc),
+            "sylvester": marg[:, SYL], "c36": marg[:, S36], "c43": marg[:, S43], "sufficient": a["sufficient"],
+            "eigenvalues": a["eigenvalues"], "radius": a["radius"],
+            "margin_bounds": [bnd[:, SYL], bnd[:, S36], bnd[:, S43]], "condition_decided": a["condition_decided"],
+            "spectrum_verdict": a["spectrum_verdict"], "verdict": a["verdict"], "boundary": a["boundary"],
+            "spectrally_stable": a["spectrally_stable"], "growth": a["growth"], "B1": B1, "C1": C1, "residual": resid}
+
+
+def free_coordinate(K: np.ndarray) -> np.ndarray:
+    """Per set: how many coordinates the stiffness leaves free (an exactly zero row and
+    column: no restoring moment, as alpha at zeta = 0); each has an exact double zero root,
+    unless the zero entries are a rounding coincidence, which the analysis rules out by the
+    margins' bounds."""
+    z = np.all(K == 0, axis=2) & np.all(K == 0, axis=1)
+    return np.sum(z, axis=1)
+
+
+# ------------------------------------------------------------------ the conditions' hooks
+# (gyro/analyses/conditions.py calls these through the model's declaration `system`)
+
+OPTIONS = ("orbit",)  # `gyro stability --orbit`, `gyro map --orbit`: a circular orbit (4.1)
+# the declared margins (derive/models/gyrohorizoncompass.py `conditions`), in their order
+SYL, S36, S43 = slice(0, 4), slice(4, 10), slice(10, 13)
+
+
+def condition_parameters(m, sets: dict, options: dict, need_equilibrium: bool) -> dict:
+    return parameters(sets, orbit=options.get("orbit", False), need_equilibrium=need_equilibrium)
+
+
+def condition_equilibrium(m, P: np.ndarray):
+    """The relative equilibrium (3.1) in closed form: (0, 0, 0, epsilon0)."""
+    eps0, _, _ = _closed_form(m, P)
+    qe = np.zeros((P.shape[0], 4))
+    qe[:, 3] = eps0
+    return qe, np.isfinite(eps0)
+
+
+def condition_conservative(m, M, D, K) -> np.ndarray:
+    """(1.5)-(1.6) have gyroscopic and potential forces only (the sensor's moment (2.1) is
+    the gradient of its potential): a Hamiltonian spectrum at every set."""
+    return np.ones(len(M), bool)
+
+
+def condition_free(m, M, D, K) -> np.ndarray:
+    return free_coordinate(K)
+
+
+def conditions_in_force(m, P: np.ndarray, marg: np.ndarray, bnd: np.ndarray, options: dict) -> list:
+    """The sufficient condition in force at each set, its margins and their rounding bounds:
+    (4.3) on the orbit, (3.6) where lambda = 1 + chi, C1's minors alone elsewhere; C1's
+    minors are required with the printed rows, which are C1 > 0 only given zeta != 0 and
+    epsilon0 != 0 (the paper's own proviso), so that zeta = 0 exactly (m1 = 0: no compass
+    effect, V only semidefinite) is no 'stable'."""
+    n = P.shape[0]
+    _, margins, tc = _closed_form(m, P)
+    orbit = np.broadcast_to(np.asarray(options.get("orbit", False), bool) | bool(options.get("on_orbit")), (n,))
+    syl, c36, c43 = marg[:, SYL], marg[:, S36], marg[:, S43]
+    b_syl, b36, b43 = bnd[:, SYL], bnd[:, S36], bnd[:, S43]
     # 3: (3.6) with eta != 0, where (3.2) makes lambda = 1 + chi exact at the decimal inputs,
     # so that m2 = m1 I row5, m3 = m2 c22, m4 = m2 c44 row6 exactly: given the printed rows,
     # C1 > 0 needs only m1 > 0 (zeta != 0) and c44 > 0 (epsilon0 != 0: I lambda zeta/2L < 1).
     # The expanded bounds of m2..m4 are hundreds of times looser than those of the factored
     # rows: required, they made a set 1e-13 off the row chi = 0.32 a boundary although its
     # rows and its spectrum both decide it.
-    which = np.where(orbit, 2, np.where(exact, np.where(P[:, 8] != 0, 3, 1), 0))
+    which = np.where(orbit, 2, np.where(_exact(P, tc), np.where(P[:, 8] != 0, 3, 1), 0))
     ratio = 1 - margins[:, :1]
-    # the existence margin 1 - I lambda zeta/2L by the rule of condition_rounding: d = 4
+    # the existence margin 1 - I lambda zeta/2L by the rule of conditions_rounding: d = 4
     # factors, N = 2 terms, k = 2 d + N = 10, sum |t| = 1 + ratio (lambda itself computed as
     # 1 + (C - B)/I: a few u more, inside the factor)
     exists_bound = 10 * U * (1 + np.abs(ratio))
-    held, decided, why = (np.empty(n, bool), np.empty(n, bool), np.empty(n, object))
-    rounded = np.zeros(n, bool)
-    # the printed rows are C1 > 0 only given zeta != 0 and epsilon0 != 0 (the paper's own
-    # proviso): C1's minors are required with them, so that zeta = 0 exactly (m1 = 0: no
-    # compass effect, V only semidefinite) is no 'stable'
     both = lambda a, b: np.concatenate([a, b], axis=1)  # noqa: E731
-    for code, marg, bnd, names in ((0, syl, bounds[0], SYLVESTER),
-                                   (1, both(c36, syl), both(bounds[1], bounds[0]), C36 + SYLVESTER),
-                                   (2, both(c43, syl), both(bounds[2], bounds[0]), C43 + SYLVESTER),
-                                   (3, both(both(c36, syl[:, :1]), margins[:, :1]),
-                                    both(both(bounds[1], bounds[0][:, :1]), exists_bound),
-                                    C36 + SYLVESTER[:1] + ("(3.1) 1 - I lambda zeta/2L",))):
-        rows = which == code
-        if rows.any():
-            held[rows], decided[rows], why[rows] = verdict.condition(marg[rows], bnd[rows], names)
-            # a margin near zero whose terms do not all vanish: its zero is rounding's
-            rounded[rows] = np.any((np.abs(marg[rows]) <= bnd[rows]) & (bnd[rows] > 0), axis=1)
-    sufficient = held & ok
-    # a free coordinate is exact only where no margin is zero merely within rounding (at
-    # zeta = 0 every term of m1 vanishes; at lambda + theta - chi = 0 on the orbit c11 may
-    # round to 0 exactly, yet nearby inputs give either sign)
-    free = np.where(rounded, 0, free_coordinate(K))
-    spec = verdict.spectrum(eig, radius, conservative=True, exact_zero=free)
-    # an infinite radius of a finite eigenvalue is a computed Jordan block (the eigenvectors
-    # exactly parallel: kappa = inf), as where c11 rounds to 0 at a scale other than 1 on
-    # (4.3)'s lambda + theta - chi = 0: rounding decides, a boundary, never 'unknown' (which
-    # the maps have no class for)
-    jordan = ok & (spec.label == "unknown")
-    spec.label[jordan] = "boundary"
-    spec.reason[jordan] = "a defective root (exactly parallel eigenvectors: a Jordan block): rounding decides"
-    growth = np.max(eig.real, axis=1)
-    stable = ok & ((spec.label == "stable") | sufficient)  # C1 > 0 puts the spectrum on the axis
-    # the verdict of the set: (3.6)/(4.3) decided and holding is stable whatever the spectrum;
-    # otherwise the spectrum's, unless the condition is undecided and the spectrum not
-    # certainly unstable (then whether it holds, or the set is only spectrally stable, is
-    # rounding's choice: a boundary)
-    label, reason = spec.label.copy(), spec.reason.copy()
-    label[sufficient] = "stable"
-    reason[sufficient] = None
-    # (an exact zero root, marginal, explains an undecided margin: it stays marginal)
-    undecided = ok & ~decided & (spec.label != "unstable") & (spec.label != "marginal")
-    label[undecided], reason[undecided] = "boundary", why[undecided]
-    label[~ok], reason[~ok] = "failed", "no relative equilibrium, or an operator that is not finite"
-    return {"epsilon0": eps0[:, 0], "exists": margins[:, 0], "theta": tc[:, 0], "chi": tc[:, 1],
-            "lambda_is_1_chi": exact,
-            "sylvester": syl, "c36": c36, "c43": c43, "sufficient": sufficient, "eigenvalues": eig,
-            "radius": radius, "margin_bounds": bounds, "condition_decided": decided,
-            "spectrum_verdict": spec, "verdict": verdict.make(label, reason),
-            "boundary": label == "boundary",
-            "spectrally_stable": stable, "growth": growth, "B1": B1, "C1": C1, "residual": resid}
+    return [(which == 0, syl, b_syl, SYLVESTER),
+            (which == 1, both(c36, syl), both(b36, b_syl), C36 + SYLVESTER),
+            (which == 2, both(c43, syl), both(b43, b_syl), C43 + SYLVESTER),
+            (which == 3, both(both(c36, syl[:, :1]), margins[:, :1]), both(both(b36, b_syl[:, :1]), exists_bound),
+             C36 + SYLVESTER[:1] + ("(3.1) 1 - I lambda zeta/2L",))]
 
 
-def free_coordinate(K: np.ndarray) -> np.ndarray:
-    """Per set: how many coordinates the stiffness leaves free (an exactly zero row and
-    column: no restoring moment, as alpha at zeta = 0); each has an exact double zero root,
-    unless the zero entries are a rounding coincidence, which `analyse` rules out by the
-    margins' bounds."""
-    z = np.all(K == 0, axis=2) & np.all(K == 0, axis=1)
-    return np.sum(z, axis=1)
+def condition_options(m, values: dict, options: dict) -> dict:
+    """One set's analysis takes (4.3) where the set lies on the orbit (zeta = nu, eta = 0)
+    without --orbit too (its name stays (3.6))."""
+    return dict(options, on_orbit=on_orbit(values))
+
+
+def condition_name(m, options: dict) -> str:
+    return "(4.3)" if options.get("orbit") else "(3.6)"
+
+
+def condition_report(m, values: dict, a: dict, options: dict) -> dict:
+    """What `gyro stability` shows: the rows of (3.6) where lambda = 1 + chi (which they
+    assume), the rows of (4.3) on the orbit, and C1's Sylvester minors always."""
+    P = m.vector(values)[None]
+    eps0, _, tc = _closed_form(m, P)
+    shown = list(C36) if _exact(P, tc)[0] else []
+    if options.get("orbit") or options.get("on_orbit"):
+        shown += list(C43)
+    shown += list(SYLVESTER)
+    theta, chi = float(tc[0, 0]), float(tc[0, 1])
+    return {"equilibrium": {"alpha": 0.0, "beta": 0.0, "gamma": 0.0, "epsilon0": float(eps0[0])},
+            "extra": {"theta": theta, "chi": chi}, "shown": shown, "condition": condition_name(m, options),
+            "lines": ["relative equilibrium (3.1): alpha = beta = gamma = 0, "
+                      f"epsilon0 = {float(eps0[0]):.9g} rad",
+                      f"theta = (C - A)/I = {theta:.6g}, chi = (C - B)/I = {chi:.6g}"]}
+
+
+def condition_axes(m) -> tuple:
+    return DERIVED
+
+
+def condition_check_axes(m, names, options: dict) -> None:
+    if options.get("orbit") and set(map(cli_name, names)) & {"zeta", "eta"}:
+        raise ParameterError("--orbit sets zeta = nu and eta = 0: neither can be an axis")
+
+
+def _lambda_follows(sets: dict) -> bool:
+    return "lambda" not in {cli_name(k) for k in sets}
+
+
+def condition_point(m, base: dict, axes: dict, options: dict, sets: dict) -> dict:
+    """The values at one grid point: the axes set (theta and chi move A and B), zeta = nu and
+    eta = 0 on the orbit, lambda = 1 + chi unless given or an axis; checked, the
+    equilibrium (3.1) included (ParameterError naming the point)."""
+    v = dict(base)
+    for name, value in axes.items():
+        v = with_axis(v, cli_name(name), value)
+    if options.get("orbit"):
+        v["zeta"], v["eta"] = v["nu"], 0.0
+    if _lambda_follows(sets) and "lambda" not in map(cli_name, axes):
+        v["lam"] = 1.0 + (v["C"] - v["B"]) / v["I"]
+    where = "at " + ", ".join(f"{cli_name(k)} = {x:.6g}" for k, x in axes.items())
+    for k, p in v.items():
+        try:
+            _check(cli_name(k), p)
+        except ParameterError as exc:
+            raise ParameterError(f"{exc} ({where})") from None
+    try:
+        check_equilibrium(v)
+    except ParameterError as exc:
+        raise ParameterError(f"{exc} ({where})") from None
+    return v
+
+
+def condition_moved(m, names, options: dict, sets: dict) -> set:
+    """The declared parameters a map moves: its axes (theta moves A, chi B), lambda where
+    it follows 1 + chi, zeta and eta on the orbit."""
+    names = set(map(cli_name, names))
+    moved = {m.canonical(k) for k in names} | {k for k, d in (("A", "theta"), ("B", "chi")) if d in names}
+    if _lambda_follows(sets):
+        moved.add("lam")
+    if options.get("orbit"):
+        moved |= {"zeta", "eta"}
+    return moved
 
 
 def stability(values: dict, orbit: bool = False):
     """The relative equilibrium of one set, its conditions and its spectrum, as a
-    gyro.results.EquilibriumStability (the `gyro stability --json` document). Conditions:
-    the rows of (3.6) where lambda = 1 + chi (which they assume), the rows of (4.3) on the
-    orbit, and C1's Sylvester minors always."""
-    from gyro.results import EquilibriumStability
+    gyro.results.EquilibriumStability (the `gyro stability --json` document)."""
+    from gyro.analyses import conditions
 
-    m = model()
-    a = analyse(m.vector(values)[None], orbit or on_orbit(values))
-    conditions = {}
-    if a["lambda_is_1_chi"][0]:  # the printed rows of (3.6) assume lambda = 1 + chi
-        conditions.update(zip(C36, map(float, a["c36"][0])))
-    if orbit or on_orbit(values):
-        conditions.update(zip(C43, map(float, a["c43"][0])))
-    conditions.update(zip(SYLVESTER, map(float, a["sylvester"][0])))
-    bounds = {}
-    if a["lambda_is_1_chi"][0]:
-        bounds.update(zip(C36, map(float, a["margin_bounds"][1][0])))
-    if orbit or on_orbit(values):
-        bounds.update(zip(C43, map(float, a["margin_bounds"][2][0])))
-    bounds.update(zip(SYLVESTER, map(float, a["margin_bounds"][0][0])))
-    eig, radii = a["eigenvalues"][0], a["radius"][0]
-    order = np.lexsort((eig.real, eig.imag))
-    eig, radii = eig[order], radii[order]
-    v = a["verdict"]
-    return EquilibriumStability(
-        verdict=str(v.label[0]), boundary_reason=v.reason[0] if v.label[0] in ("boundary", "marginal") else None,
-        margin_bounds=bounds, radii=radii,
-        model=MODEL, title=m.meta["title"], params=cli_params(values), aliases=m.aliases,
-        equilibrium={"alpha": 0.0, "beta": 0.0, "gamma": 0.0, "epsilon0": float(a["epsilon0"][0])},
-        theta=float(a["theta"][0]), chi=float(a["chi"][0]), conditions=conditions,
-        sufficient=bool(a["sufficient"][0]), orbit=bool(orbit),
-        eigenvalues=np.stack([eig.real, eig.imag], axis=1), spectrally_stable=bool(a["spectrally_stable"][0]))
+    return conditions.stability(model(), values, {"orbit": orbit} if orbit else {})
 
 
 def frequencies(values: dict) -> np.ndarray:
@@ -300,62 +359,21 @@ def energy_bound(values: dict) -> float:
 # ------------------------------------------------------------------ maps
 
 
-def parse_axis(flag: str, text: str) -> tuple[str, float, float, int]:
-    """NAME=LO:HI:N over a parameter (its declared name or another taken for it) or theta,
-    chi -> (this module's name, lo, hi, n)."""
-    name, lo, hi, n = grid_axis(flag, text, NAMES + DERIVED + tuple(model().aliases.values()), 1000)
-    return cli_name(name), lo, hi, n
-
-
 def condition_map(base: dict, xaxis, yaxis, orbit: bool = False, lambda_follows: bool = True):
     """The (3.6) region, the spectrally stable one and the unstable one over a grid of two
     axes ((name, lo, hi, n) each: parameters or theta, chi), lambda following 1 + chi when
-    `lambda_follows` (and lambda is no axis). Values: 2 where the sufficient condition holds, 1 spectrally stable
-    outside it, 0 unstable, -1 (BOUNDARY) where rounding could change the verdict, -2
-    (MARGINAL) an exact zero root. Every grid point is checked first (ParameterError naming the
-    axis value where a parameter is out of range or there is no equilibrium)."""
-    from gyro.results import ConditionMap
+    `lambda_follows` (and lambda is no axis): gyro.analyses.conditions.condition_map over
+    the values `base` (model keys)."""
+    from gyro.analyses import conditions
 
-    m = model()
-    (xn, xlo, xhi, nx), (yn, ylo, yhi, ny) = xaxis, yaxis
-    if xn == yn:
-        raise ParameterError(f"--x and --y are both {xn!r}")
-    x, y = np.linspace(xlo, xhi, nx), np.linspace(ylo, yhi, ny)
-    sets = []
-    for yv in y:
-        for xv in x:
-            v = with_axis(with_axis(base, xn, xv), yn, yv)
-            if orbit:
-                v["zeta"], v["eta"] = v["nu"], 0.0
-            if lambda_follows and "lambda" not in (xn, yn):
-                v["lam"] = 1.0 + (v["C"] - v["B"]) / v["I"]
-            where = f"at {xn} = {xv:.6g}, {yn} = {yv:.6g}"
-            for k, p in v.items():
-                try:
-                    _check(cli_name(k), p)
-                except ParameterError as exc:
-                    raise ParameterError(f"{exc} ({where})") from None
-            try:
-                check_equilibrium(v)
-            except ParameterError as exc:
-                raise ParameterError(f"{exc} ({where})") from None
-            sets.append(v)
-    a = analyse(m.vectors(sets), orbit)
-    label = a["verdict"].label
-    values = np.select([label == "boundary", label == "marginal", a["sufficient"], label == "stable"],
-                       [BOUNDARY, MARGINAL, 2, 1], 0).reshape(ny, nx)
-    # the growth of a certainly unstable set; 0 elsewhere (a boundary's growth is rounding's)
-    growth = np.where(label == "unstable", np.maximum(a["growth"], 0.0), 0.0).reshape(ny, nx)
-    moved = {xn, yn} | {k for k, d in (("A", "theta"), ("B", "chi")) if d in (xn, yn)}
+    sets = {cli_name(k): v for k, v in base.items() if cli_name(k) not in (xaxis[0], yaxis[0])}
     if lambda_follows:
-        moved.add("lambda")
+        sets.pop("lambda", None)
     if orbit:
-        moved |= {"zeta", "eta"}
-    return ConditionMap(model=MODEL, title=m.meta["title"], xname=m.canonical(xn), yname=m.canonical(yn), x=x, y=y,
-                        values=values.astype(int), growth=growth, orbit=bool(orbit),
-                        boundary=(label == "boundary").reshape(ny, nx),
-                        reasons=a["verdict"].reason.reshape(ny, nx),
-                        base={k: v for k, v in cli_params(base).items() if cli_name(k) not in moved})
+        sets.pop("zeta", None), sets.pop("eta", None)
+    if xaxis[0] == yaxis[0]:
+        raise ParameterError(f"--x and --y are both {xaxis[0]!r}")
+    return conditions.condition_map(model(), sets, xaxis, yaxis, {"orbit": orbit} if orbit else {})
 
 
 # ------------------------------------------------------------------ motions

@@ -5,14 +5,16 @@ Inertia A (equatorial) and C (polar) about the fixed point, mass m, mass centre 
 symmetry axis, gravity g. The spin turns steadily at the rate n (a declared steady motion,
 phi ignorable since A = B); the reference is the upright top alpha = beta = 0.
 Textbook answer (Maievski's condition): the sleeping top is stable iff C^2 n^2 > 4 A m g l;
-the tilt block's characteristic polynomial is (A p^2 - m g l)^2 + (C n p)^2.
+the tilt block's characteristic polynomial is (A p^2 - m g l)^2 + (C n p)^2. The condition is
+declared (Model.conditions) as one margin, C^2 n^2 - 4 A m g l, for `gyro stability` and
+`gyro map`.
 """
 from __future__ import annotations
 
 import sympy as sp
 
 from derive import mechanics as mech
-from derive.model import Model, Parameter
+from derive.model import Conditions, Model, Parameter
 
 NAME = "symmetric_top"
 PARAMETERS = [
@@ -45,4 +47,7 @@ def build() -> Model:
         lagrangian=T - V,
         steady={"phi": n},
         symmetric_zero=["alpha", "beta"],
+        conditions={"Maievski": Conditions([("C^2 n^2 - 4 A m g l", C**2 * n**2 - 4 * A * m * g * l)],
+                                           "the sleeping top's condition: the spin's gyroscopic "
+                                           "stiffness beats the toppling moment")},
     )

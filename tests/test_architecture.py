@@ -125,3 +125,21 @@ def test_the_wheel_lists_every_package():
     listed = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"])
     found = {".".join(p.parent.relative_to(ROOT).parts) for p in GYRO.rglob("__init__.py")}
     assert listed - {"gyro.generated"} == found
+
+
+def test_no_command_or_analysis_knows_a_model_by_name():
+    """What only one paper's system has lives in gyro/systems, reached through what the model
+    declares: no built-in model's name appears in gyro/cli/ or gyro/analyses/ (code, help or
+    docstring), and nothing outside gyro/systems imports it (the runtime loads a declared
+    module with gyro.catalog.declared_module)."""
+    names = sorted(p.name for p in (ROOT / "generated").iterdir() if (p / "metadata.json").is_file())
+    assert len(names) >= 4
+    for folder in ("cli", "analyses"):
+        for path in sorted((GYRO / folder).rglob("*.py")):
+            text = path.read_text()
+            found = [n for n in names if n in text]
+            assert not found, f"{path.relative_to(ROOT)} names {found}"
+    g = import_graph()
+    for m, deps in g.items():
+        if not m.startswith("gyro.systems"):
+            assert not [d for d in deps if d.startswith("gyro.systems")], m

@@ -23,7 +23,7 @@ def register(sub) -> None:
                                    f"{NEEDS}",
                        description=f"The model's sufficient condition against the spectrum over a grid of two axes. "
                                    f"MODEL {NEEDS}.")
-    add_model(s, help=f"the model ({NEEDS})")
+    add_model(s, help=f"the model ({NEEDS})", declares=lambda meta: bool(meta.get("conditions")))
     s.add_argument("--x", required=True, metavar="NAME=LO:HI:N", help="x axis: a parameter (or an axis the model's "
                    "system adds, as theta, chi)")
     s.add_argument("--y", required=True, metavar="NAME=LO:HI:N", help="y axis: as --x")

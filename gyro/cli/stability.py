@@ -23,7 +23,7 @@ def register(sub) -> None:
     s = sub.add_parser("stability", help=f"sufficient conditions against the spectrum; {NEEDS}",
                        description=f"The equilibrium, the margins of the model's sufficient conditions and the "
                                    f"spectrum of its linearisation, with the verdict. MODEL {NEEDS}.")
-    add_model(s, help=f"the model ({NEEDS})")
+    add_model(s, help=f"the model ({NEEDS})", declares=lambda meta: bool(meta.get("conditions")))
     add_set(s, "a parameter's value (gyro params MODEL lists them), in the model's units")
     s.add_argument("--orbit", action="store_true",
                    help="a satellite on a circular orbit (zeta = nu, eta = 0 (4.1)): an option of the "

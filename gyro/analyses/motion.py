@@ -341,3 +341,99 @@ def group_max(v: np.ndarray, units: list) -> np.ndarray:
             idx = [half + j for j, u in enumerate(units) if u == unit]
             out[idx] = np.max(v[idx])
     return out
+
+
+# ----------------------------------------------------------------------------- the motion question
+# The `motion` question's levels for any model (gyro/questions/motion.py): a level declares
+# {"kind": "trajectory", "module": "gyro.analyses.motion", "method": "linear" | a SciPy
+# method, "rtol": R, "quantities": the reduced coordinates}; for_model(model) gives the
+# protocol's INITIAL, Motion and motion_answer. The constants are the torsion gyrocompass's,
+# measured there (gyro.systems.torsion_gyrocompass, docs/hierarchy.md) and checked on models
+# written outside the package (tests/test_motion_generic.py).
+FACTOR = 2.0  # the bound over the correction: measured error/bound 0.50..0.55 below the cap (bench)
+# the largest estimate, over the motion's largest excursion (the question's scale), for which
+# it is a bound: measured on the torsion gyrocompass error over it 0.50..0.55 up to 0.15, 0.62
+# at 0.30, 0.77 at 0.58, 1.0 at 0.84, 2.0 at 1.3 (bench/results/levels.json 'toward_the_cap')
+CAP = 0.25
+ROUNDING = 4.0  # the exponential's rounding per step, in eps of the largest |z_L|
+CORRECTIONS = 2  # Picard steps: the second holds every term of third order
+FINE = 32  # samples per shortest period 2 pi/(2 omega_max) of the remainder's quadratic terms
+FINER = 1e-2  # the integrated level's second run's tolerance, of the first's
+FLOOR = 100.0  # the integrator's absolute tolerance, at least this many eps of the reference
+
+
+class _Generic:
+    """The motion protocol of one model: INITIAL over its reduced coordinates (`<c>_0`, a
+    displacement from the reference, `<c>_d0`, a rate offset, all 0 by default), Motion and
+    motion_answer."""
+
+    def __init__(self, model):
+        self.model = model
+        units = model.meta.get("coordinate_units", {})
+        self.reduced = list(model.meta["reduced"])
+        self.units = [units.get(c, "") for c in self.reduced]
+        self.INITIAL = {}
+        for c, u in zip(self.reduced, self.units):
+            self.INITIAL[f"{c}_0"] = (u, 0.0, f"{c} at t = 0, off its reference")
+            self.INITIAL[f"{c}_d0"] = (f"{u}/s" if u else "1/s", 0.0, f"the rate of {c} at t = 0, off its reference")
+
+    def Motion(self, params: dict, **initial):
+        unknown = sorted(set(initial) - set(self.INITIAL))
+        if unknown:
+            raise ParameterError(f"{self.model.name} motion: unknown initial condition {unknown[0]!r}; "
+                                 f"it takes {', '.join(self.INITIAL)}")
+        vals = {k: float(initial.get(k, v[1])) for k, v in self.INITIAL.items()}
+        bad = [k for k, v in vals.items() if not np.isfinite(v)]
+        if bad:
+            raise ParameterError(f"--set {bad[0]}: the initial condition must be a finite number")
+        z0 = np.array([vals[f"{c}_0"] for c in self.reduced] + [vals[f"{c}_d0"] for c in self.reduced])
+        return _Motion(self.model, dict(params), z0)
+
+    def motion_answer(self, motion, t, method: str = "linear", rtol: float = 1e-9):
+        """The reduced coordinates q_ref + x at the times t (times, n) and an estimate of each
+        one's largest absolute error over t."""
+        return motion_answer(motion.reduced, motion.z0, t, self.units, method, rtol)
+
+
+class _Motion:
+    def __init__(self, model, params: dict, z0: np.ndarray):
+        self.model, self.params, self.z0 = model, params, z0
+
+    @cached_property
+    def reduced(self) -> ReducedState:
+        return ReducedState(self.model, self.params)
+
+
+def linear_answer(red: ReducedState, z0: np.ndarray, t, units: list, cap: float = CAP):
+    """The linear level's answer: q_ref + x_L at the times t (times, n) and its estimate,
+    FACTOR times the correction's largest |e| over each coordinate's unit group plus the
+    rounding, infinite where its largest exceeds `cap` of the motion's largest excursion
+    (an error map measures the uncapped estimate with cap = inf)."""
+    n = red.n
+    zL, e, per = linear_motion(red, z0, t, CORRECTIONS, FINE)
+    est = FACTOR * group_max(np.max(np.abs(e), axis=0), units)[:n]
+    est += ROUNDING * np.finfo(float).eps * per * (len(t) - 1) * np.max(np.abs(zL[:, :n]))
+    excursion = np.max(np.sqrt(np.sum((zL[:, :n] - zL[:1, :n]) ** 2, axis=1)))
+    if not np.max(est) <= cap * excursion:  # beyond the iteration's reach: no bound
+        est = np.full(n, np.inf)
+    return red.q_ref[red.ri] + zL[:, :n], est
+
+
+def motion_answer(red: ReducedState, z0: np.ndarray, t, units: list, method: str = "linear", rtol: float = 1e-9):
+    """The `motion` question's answer from the reduced state z0: `linear` (linear_answer), or
+    the full equations integrated by a SciPy method at rtol and rtol FINER, the estimate
+    twice their difference, not below twice the finer run's tolerance on the coordinates'
+    size (an error the two runs share where both sit at the absolute tolerance's floor)."""
+    t = np.asarray(t, float)
+    if method == "linear":
+        return linear_answer(red, z0, t, units)
+    n = red.n
+    zL = linear_motion(red, z0, t, CORRECTIONS, FINE)[0]
+    scale = np.array([np.max(np.abs(zL[:, :n])), np.max(np.abs(zL[:, n:]))])
+    q, est = ode.two_tolerances(lambda r: integrate_reduced(red, z0, t, method, r, scale, FLOOR), rtol, FINER)
+    return q, np.maximum(est, 2 * rtol * FINER * group_max(np.max(np.abs(q), axis=0), units))
+
+
+def for_model(model) -> _Generic:
+    """The `motion` question's protocol (INITIAL, Motion, motion_answer) for this model."""
+    return _Generic(model)

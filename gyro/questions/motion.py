@@ -4,7 +4,8 @@ over the horizon divided by the coordinate's largest magnitude (at least 1 rad) 
 
 Evaluator kind: `trajectory`, {"module": MODULE, "method": NAME, "rtol": R}: the module
 MODULE (a dotted name the model declares: gyro.systems.<system> for the papers' models,
-any importable module for a user's) offers INITIAL (name -> (unit, default, description): the initial
+gyro.analyses.motion for any model's linear motion and its integration, any importable
+module for a user's; a module with for_model(model) gives the following per model) offers INITIAL (name -> (unit, default, description): the initial
 conditions, which `gyro scene` takes with --set), `Motion(params, **initial)` and
 `motion_answer(motion, t, method, rtol) -> (q (times, coordinates), absolute error
 estimate per coordinate)`. An evaluator that refuses a set (the closed form with C0 != 0)
@@ -29,8 +30,11 @@ POINTS = 201  # sample times over the horizon
 DEFAULT_HORIZON = 1.0  # s
 
 
-def _analysis(level):
-    return evaluator_module(level)
+def _analysis(level, model):
+    """The level's evaluator: its module, or what the module gives for this model where it
+    serves any model (gyro.analyses.motion.for_model)."""
+    mod = evaluator_module(level)
+    return mod.for_model(model) if hasattr(mod, "for_model") else mod
 
 
 def initial_conditions(model) -> dict:
@@ -41,7 +45,7 @@ def initial_conditions(model) -> dict:
     out = {}
     for lv in levels(model):
         if lv.answers_question(NAME) and lv.evaluator.get("kind") == "trajectory":
-            out.update(_analysis(lv).INITIAL)
+            out.update(_analysis(lv, model).INITIAL)
     return out
 
 
@@ -88,7 +92,7 @@ def subset(opts: dict, rows: np.ndarray, n: int) -> dict:
 def answer(model, level, P, opts) -> Answer:
     if level.evaluator.get("kind") != "trajectory":
         raise unknown_kind(NAME, level)
-    mod = _analysis(level)
+    mod = _analysis(level, model)
     t = times(opts)
     init = {k: v[1] for k, v in mod.INITIAL.items()}  # (unit, default, description)
     init.update(opts.get("initial", {}))

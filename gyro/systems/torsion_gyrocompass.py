@@ -65,16 +65,10 @@ for _c in REDUCED:
                           f"{_WHAT[_c]} at t = 0, off its equilibrium value")
     INITIAL[f"{_c}_d0"] = (_UNIT[_c] + "/s", 0.0, f"the rate of {_WHAT[_c]} at t = 0")
 
-FACTOR = 2.0  # the bound over the correction: measured error/bound 0.50..0.55 below the cap (bench)
-# the largest estimate, over the motion's largest excursion (the question's scale), for which
-# it is a bound: measured error over it 0.50..0.55 up to 0.15, 0.62 at 0.30, 0.77 at 0.58,
-# 1.0 at 0.84, 2.0 at 1.3 (bench/results/levels.json 'toward_the_cap', docs/hierarchy.md)
-CAP = 0.25
-ROUNDING = 4.0  # the exponential's rounding per step, in eps of the largest |z_L|
-CORRECTIONS = 2  # Picard steps: the second holds every term of third order (docs/hierarchy.md)
-FINE = 32  # samples per shortest period 2 pi/(2 omega_max) of the remainder's quadratic terms
-FINER = 1e-2  # the integrator's second run's tolerance, of the first's
-FLOOR = 100.0  # the integrator's absolute tolerance, at least this many eps of the equilibrium
+# the linear level's constants, measured on this model (bench/results/levels.json
+# 'toward_the_cap', docs/hierarchy.md) and shared by the generic machinery, which keeps them
+# (gyro.analyses.motion: FACTOR, CAP, ROUNDING, CORRECTIONS, FINE, FINER, FLOOR)
+CAP, FINE, CORRECTIONS, FLOOR = generic.CAP, generic.FINE, generic.CORRECTIONS, generic.FLOOR
 
 
 class Motion:
@@ -130,44 +124,17 @@ def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-9, sca
     return generic.integrate_reduced(motion.reduced, motion.z0, t, method, rtol, scale, FLOOR)
 
 
-def _group_max(v: np.ndarray) -> np.ndarray:
-    """Per entry of x (n) or (x, x') (2n), the largest of its unit group (m, rad, their rates)."""
-    return generic.group_max(v, [_UNIT[c] for c in REDUCED])
-
-
 def linear_answer(motion: Motion, t, cap: float = CAP):
-    """The linear level's answer: q0 + x_L at the times t (times, n) and its estimate, FACTOR
-    times the correction's largest |e| over each coordinate's unit group plus the rounding,
-    infinite where its largest exceeds `cap` of the motion's largest excursion (the error
-    map measures the uncapped estimate with cap = inf)."""
-    S = motion.reduced
-    n = S.n
-    zL, e, per = linear_motion(motion, t)
-    est = FACTOR * _group_max(np.max(np.abs(e), axis=0))[:n]
-    est += ROUNDING * np.finfo(float).eps * per * (len(t) - 1) * np.max(np.abs(zL[:, :n]))
-    excursion = np.max(np.sqrt(np.sum((zL[:, :n] - zL[:1, :n]) ** 2, axis=1)))
-    if not np.max(est) <= cap * excursion:  # beyond the iteration's reach: no bound
-        est = np.full(n, np.inf)
-    return S.q_ref[S.ri] + zL[:, :n], est
+    """The linear level's answer (gyro.analyses.motion.linear_answer with this model's
+    constants, which the generic machinery shares)."""
+    return generic.linear_answer(motion.reduced, motion.z0, np.asarray(t, float), [_UNIT[c] for c in REDUCED], cap)
 
 
 def motion_answer(motion: Motion, t, method: str = "linear", rtol: float = 1e-9):
     """The `motion` question's evaluator (gyro/questions/motion.py): the reduced coordinates
     q0 + x at the times t (times, 10) and an estimate of each one's largest absolute error
-    over t (m, rad)."""
-    t = np.asarray(t, float)
-    n = motion.reduced.n
-    if method == "linear":
-        return linear_answer(motion, t)
-    from gyro import ode
-
-    zL = linear_motion(motion, t)[0]
-    scale = np.array([np.max(np.abs(zL[:, :n])), np.max(np.abs(zL[:, n:]))])
-    q, est = ode.two_tolerances(lambda r: integrate(motion, t, method, r, scale), rtol, FINER)
-    # not below twice the finer run's tolerance on the coordinates' size (the equilibrium's
-    # offsets included): an error the two runs share where both sit at the absolute
-    # tolerance's floor, which their difference does not see (the smallest perturbations)
-    return q, np.maximum(est, 2 * rtol * FINER * _group_max(np.max(np.abs(q), axis=0)))
+    over t (m, rad), by the generic machinery (gyro.analyses.motion.motion_answer)."""
+    return generic.motion_answer(motion.reduced, motion.z0, t, [_UNIT[c] for c in REDUCED], method, rtol)
 
 
 # ----------------------------------------------------------------------------- the linear limit

@@ -128,3 +128,18 @@ def test_every_saving_result_loads_what_it_saved(tmp_path):
     back = FrequencySweep.load(tmp_path / "s.npz")
     np.testing.assert_array_equal(back.spectrum.frequencies, spec.frequencies)
     assert back.to_dict() == sweep.to_dict() and back.table() == sweep.table()
+
+
+def test_a_campbell_diagram_loads_its_crossings_as_crossings(tmp_path):
+    """The critical speeds come back as Crossing objects (list[Crossing] rebuilt entry by
+    entry), not as dicts, and the loaded diagram prints the same table."""
+    from gyro.analyses.campbell import campbell
+    from gyro.results.campbell import Crossing
+
+    H = MODEL.defaults["H"]
+    d = campbell(MODEL, MODEL.defaults, None, np.linspace(0.2 * H, 2.0 * H, 12), harmonics=(1,))
+    assert d.crossings, "the sweep should cross a mode"
+    d.save(tmp_path / "c.npz")
+    back = CampbellDiagram.load(tmp_path / "c.npz")
+    assert all(isinstance(c, Crossing) for c in back.crossings) and back.crossings == d.crossings
+    assert back.crossings_table() == d.crossings_table()

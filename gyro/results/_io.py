@@ -68,7 +68,8 @@ def _hints(cls) -> dict:
 
 def _rebuild(tp, value):
     """A field saved as JSON back in its declared type: a nested result (a dataclass, e.g.
-    a sweep's Spectrum) field by field, an array from its list (complex from re/im)."""
+    a sweep's Spectrum) field by field, a list[X] entry by entry, an array from its list
+    (complex from re/im)."""
     import types
     import typing
 
@@ -77,6 +78,9 @@ def _rebuild(tp, value):
     args = [a for a in typing.get_args(tp) if a is not type(None)]
     if typing.get_origin(tp) in (typing.Union, types.UnionType) and args:  # X | None: X
         tp = args[0]
+    if typing.get_origin(tp) is list and isinstance(value, list) and typing.get_args(tp):
+        item = typing.get_args(tp)[0]  # list[X]: each entry rebuilt as an X (a Campbell crossing)
+        return [_rebuild(item, v) for v in value]
     if is_dataclass(tp) and isinstance(value, dict):
         hints = _hints(tp)
         names = {f.name for f in fields(tp)}
@@ -87,8 +91,6 @@ def _rebuild(tp, value):
         arr = np.asarray(value)
         return arr if arr.dtype != object or not arr.size else np.array(value, dtype=object)
     return value
-
-
 
 
 def _jsonable(v):

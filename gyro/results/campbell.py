@@ -48,7 +48,7 @@ class CampbellDiagram(Result):
     tracked: Spectrum | None = None  # modes tracked by MAC (frequencies, growth, modes)
     whirl: np.ndarray | None = None  # (points, modes) 'forward', 'backward', 'mixed' or None
     harmonics: list = field(default_factory=list)  # the k of the lines k x spin rate
-    crossings: list = field(default_factory=list)  # Crossing, by value
+    crossings: list[Crossing] = field(default_factory=list)
     rate_label: str = "spin rate [rad/s]"
     log: bool = True  # log axes (a geometric sweep)
     # (points, modes): tracked column j at point i is root order[i, j] of `exact` (0-based),

@@ -471,10 +471,17 @@ def _shown(path: Path) -> str:
         return path.name
 
 
+# derive/ sources that cannot change a byte of the output: the command line and the
+# scheduling of models over processes (the bytes are the same under --jobs 1 and 2)
+NOT_OUTPUT = ("__main__.py", "parallel.py")
+
+
 def machinery_files() -> list[Path]:
-    """The shared machinery: every source of derive/ outside derive/models/, and the templates."""
+    """The shared machinery that can change the output: every source of derive/ outside
+    derive/models/ but NOT_OUTPUT, and the templates."""
     models = ROOT / "derive" / "models"
-    return sorted([f for f in (ROOT / "derive").rglob("*.py") if models not in f.parents]
+    skip = {ROOT / "derive" / name for name in NOT_OUTPUT}
+    return sorted([f for f in (ROOT / "derive").rglob("*.py") if models not in f.parents and f not in skip]
                   + list(TEMPLATES.glob("*.j2")))
 
 

@@ -23,7 +23,7 @@ derive: $(STAMP)
 	$(PY) -m derive --out generated --jobs $(JOBS)
 
 # A fresh derivation under another hash seed than the committing one's gives the committed
-# bytes; `make test` tells the test suite so (tests/test_generated.py does not derive again).
+# bytes; `make test` tells the test suite so (tests/generated/test_generated.py does not derive again).
 HASHSEED := 4242
 
 check-generated: $(STAMP)

@@ -16,7 +16,7 @@ LagrangesMethod, Linearizer), which shares no code with this project's derivatio
 
 The parameter sets move every block of the operator: the paper example, the spin H, the
 latitude phi, the three bearing stiffnesses, a light casing, and all parameters at once.
-The result is written to tests/fixtures/anchor_frequencies.json, which tests/test_anchors.py
+The result is written to tests/fixtures/anchor_frequencies.json, which tests/paper/test_anchors.py
 reads (the tests never rerun this: the baseline takes minutes).
 
     .venv/bin/python -m bench.anchor_fixture            # write the fixture

@@ -27,7 +27,7 @@ from gyro.systems import gyrohorizoncompass as ghc
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "bench" / "results"
-OFFSET = np.array([0.05, -0.03, 0.04, 0.05, 0.01, 0.0, -0.02, 0.01])  # as tests/test_gyrohorizoncompass.py
+OFFSET = np.array([0.05, -0.03, 0.04, 0.05, 0.01, 0.0, -0.02, 0.01])  # as tests/paper/test_gyrohorizoncompass.py
 PERIODS = 1e4
 RUNS = [  # (method, tolerance or steps per radian of the fastest mode, periods)
     ("cvodes", 1e-8, PERIODS), ("cvodes", 1e-10, PERIODS), ("cvodes", 1e-12, PERIODS),

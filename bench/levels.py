@@ -642,7 +642,7 @@ def rungs(quick: bool) -> dict:
     """How far above the cheapest level that was enough the selector goes: per tolerance,
     the sets whose chosen level is more than one rung (a level answering every frequency and
     not dominated there, cheapest first: gyro.analyses.scene.rungs) above the cheapest level whose measured error meets tol / margin, for
-    margins 1, 2 and 5 (tests/test_hierarchy.py holds it with no margin)."""
+    margins 1, 2 and 5 (tests/methods/test_hierarchy.py holds it with no margin)."""
     n = 100 if quick else 400
     P = joint(n, seed=12)
     ref = F.answer(TG, hierarchy.get(TG, "linear_exact:default"), P, {})

@@ -217,7 +217,7 @@ def count_ops(exprs) -> int:
     derivation repeats its subtrees many times (a 12-link chain's sensitivities spent 7 s
     in it). Its count is a sum of what each node it visits adds, each a function of the
     node alone (SUB - ADD adds nothing to the total), so memoising by node gives the
-    same sum (tests/test_machinery.py holds it to sp.count_ops)."""
+    same sum (tests/unit/test_machinery.py holds it to sp.count_ops)."""
     from sympy.core.function import _coeff_isneg
     from sympy.core.operations import LatticeOp
     from sympy.simplify.radsimp import fraction
@@ -636,7 +636,7 @@ def sorting_network(n: int) -> list[tuple[int, int]]:
     """Batcher's odd-even merge sort of n keys as comparators (a, b), a < b, in order: the
     network for the next power of two with every comparator that touches a key past n
     dropped (those keys count as larger than all, so it would never swap). After it, key a
-    is at most key b for every a < b (tests/test_ladder.py checks it on all 0-1 inputs, which
+    is at most key b for every a < b (tests/methods/test_ladder.py checks it on all 0-1 inputs, which
     suffices for a comparator network)."""
     size = 1
     while size < n:

@@ -8,7 +8,7 @@ them; only its return value travels back (for the emitter, printed text). Either
 results are those of running the tasks one after another: each task is a pure function of
 what was built before the workers were forked, the results come back in the tasks' order,
 and where tasks fail the one raised is the first by index, as a loop would raise it
-(tests/test_parallel_derive.py holds the emitted files to the bytes of a run with one job).
+(tests/generated/test_parallel_derive.py holds the emitted files to the bytes of a run with one job).
 
 Workers run on Linux only, where each is tied to its parent's life (PR_SET_PDEATHSIG): a
 worker whose parent dies (killed, out of memory, a signal) is killed with it, so that no

@@ -133,7 +133,7 @@ def eigen_radii(A: np.ndarray, M: np.ndarray):
     with kappa_i = ||x_i|| ||y_i|| / |y_i^H x_i| (right and left eigenvectors; the rows of
     X^-1 are the left ones) and ||E||_2 <= ||E||_F <= u ||A||_F (2 n_A + 3 n_A cond_2(M)):
     n_A for the rounding of the inputs and of M, D, K (measured: at most 2.4 u ||A||_F
-    against 40 digits, tests/test_verdict.py), n_A for LAPACK's QR iteration (backward
+    against 40 digits, tests/paper/test_verdict.py), n_A for LAPACK's QR iteration (backward
     error p(n) u ||A||, p(n) ~ n), 3 n_A cond(M) for the two solves with M (LU, growth 1 for
     M > 0). The factor n_A: every eigenvalue of A + E lies in a disk of radius
     n_A kappa_i ||E||_2 about some lambda_i (a Bauer-Fike theorem with individual condition
@@ -183,7 +183,7 @@ def companion_roots(M, D, K):
     number times the backward error of forming and solving the first-order problem. A
     damped or circulatory operator's first-order matrix can be far from normal, where
     eps ||A|| / |lambda| (Bauer-Fike for a normal matrix) is beaten by orders of magnitude
-    (tests/test_companion_bound.py); a defective or non-finite set gets an infinite one."""
+    (tests/methods/test_companion_bound.py); a defective or non-finite set gets an infinite one."""
     N, n = M.shape[0], M.shape[-1]
     A = companion_matrix(M, D, K)
     lam = np.full((N, n), np.nan + 0j)

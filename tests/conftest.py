@@ -13,25 +13,16 @@ GENERATED = ROOT / "generated"
 MODEL = "torsion_gyrocompass"
 
 
-# Tiers (docs/architecture.md): each test file belongs to one, marked by its name, so that
-# `pytest -m unit` (make test-unit) runs the fast tier alone; `make test` runs them all.
+# Tiers (docs/architecture.md): a test file's folder is its tier, and the tier its marker, so
+# that `pytest -m unit` (make test-unit) runs the fast tier alone; `make test` runs them all.
 TIERS = {
-    "unit": ("test_mechanics", "test_machinery", "test_architecture", "test_results", "test_model_namespace"),
-    "generated": ("test_generated", "test_textbook", "test_docs_models", "test_derivation", "test_docs_api",
-                  "test_mechanics_style", "test_speeds", "test_closed_chains", "test_derive_baselines", "test_parallel_derive"),
-    "paper": ("test_paper", "test_anchors", "test_nonlinear", "test_gimbal", "test_gimbal_closed_form",
-              "test_gimbal_section6", "test_gimbal_paper_items", "test_paper_items",
-              "test_gyrohorizoncompass", "test_verdict", "test_ghc_paper_items", "test_ghc_motion", "test_precession",
-              "test_precession_base", "test_precession_bounds"),
-    "methods": ("test_ladder", "test_companion_bound", "test_sensitivity", "test_hierarchy", "test_torsion_motion",
-                "test_scene_figures", "test_harmonic", "test_block_starts", "test_anymodel", "test_roots",
-                "test_equilibrium_c", "test_rightmodel"),
-    "properties": ("test_properties",),
-    "cli": ("test_cli", "test_gimbal_simulate", "test_readme", "test_sweep", "test_wheel", "test_ghc_cli", "test_fuzz", "test_robustness",
-            "test_tolerance", "test_executor", "test_motion_generic", "test_forced_generic", "test_precession_cli", "test_forced",
-            "test_unbalance_lagrangian", "test_campbell_stability", "test_param_names", "test_conditions"),
+    "unit": "the machinery and the runtime's shape, fast",
+    "generated": "the emitted code against the symbolic result, every backend",
+    "paper": "the papers' printed numbers and formulas, and the models' physics",
+    "methods": "the ladder of frequency methods against each other",
+    "properties": "hypothesis properties over physical ranges",
+    "cli": "the command-line contract",
 }
-_TIER_OF = {f: tier for tier, files in TIERS.items() for f in files}
 
 
 def _tested_tree_is_this_one() -> None:
@@ -70,10 +61,12 @@ def pytest_sessionstart(session):
 
 def pytest_collection_modifyitems(config, items):
     for item in items:
-        stem = Path(str(item.fspath)).stem
-        if stem not in _TIER_OF:
-            raise pytest.UsageError(f"{stem}.py belongs to no tier: add it to TIERS in tests/conftest.py")
-        item.add_marker(getattr(pytest.mark, _TIER_OF[stem]))
+        path = Path(str(item.fspath)).resolve()
+        tier = path.parent.name if path.parent.parent == ROOT / "tests" else None
+        if tier not in TIERS:
+            raise pytest.UsageError(f"{path.name} belongs to no tier: put it in a folder tests/TIER/ "
+                                    f"(TIER one of {', '.join(TIERS)})")
+        item.add_marker(getattr(pytest.mark, tier))
 
 
 @pytest.fixture(scope="session")

@@ -349,7 +349,7 @@ def group_max(v: np.ndarray, units: list) -> np.ndarray:
 # method, "rtol": R, "quantities": the reduced coordinates}; for_model(model) gives the
 # protocol's INITIAL, Motion and motion_answer. The constants are the torsion gyrocompass's,
 # measured there (paper 003's motion levels, docs/hierarchy.md) and checked on models
-# written outside the package (tests/test_motion_generic.py).
+# written outside the package (tests/cli/test_motion_generic.py).
 FACTOR = 2.0  # the bound over the correction: measured error/bound 0.50..0.55 below the cap (bench)
 # the largest estimate, over the motion's largest excursion (the question's scale), for which
 # it is a bound: measured on the torsion gyrocompass error over it 0.50..0.55 up to 0.15, 0.62

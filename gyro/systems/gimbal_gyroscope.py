@@ -591,7 +591,7 @@ def turning_points(motion: Motion, n: int = 4096) -> np.ndarray:
     # A0 (M - A0 psi'^2 - 2 P1 eta20 sin - 2 G cos) with psi' from L, which is A0 (M + 2 U1):
     # kept in this order of operations, because section 6's asymptotic motion starts at the
     # far turning point of a separatrix and one ulp there decides its motion type
-    # (tests/test_gimbal_section6.py::test_asymptotic_type_property_e; docs/gimbal.md)
+    # (tests/paper/test_gimbal_section6.py::test_asymptotic_type_property_e; docs/gimbal.md)
     def f(th):
         dpsi = (I["L"] - I["H"] * np.cos(th)) / p["A0"]
         return p["A0"] * (I["M"] - p["A0"] * dpsi**2 - 2 * p["P1"] * p["eta20"] * np.sin(th) - 2 * G * np.cos(th))

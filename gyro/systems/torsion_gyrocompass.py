@@ -50,7 +50,7 @@ from gyro.analyses.spin import spin_rate
 from gyro.models import Model, ParameterError, load
 
 MODEL = "torsion_gyrocompass"
-# the reduced coordinates (2.4), metadata 'reduced' (tests/test_torsion_motion.py holds them equal)
+# the reduced coordinates (2.4), metadata 'reduced' (tests/methods/test_torsion_motion.py holds them equal)
 REDUCED = ("x1", "x3", "gamma", "mu", "x2", "gamma1", "gamma2", "alpha", "beta", "lam")
 _WHAT = {"x1": "the rotor's shift along x1 in its bearings", "x2": "the rotor's shift along x2 (the spin axis)",
          "x3": "the rotor's shift along x3", "gamma1": "the rotor's tilt gamma1 in its bearings",
@@ -156,7 +156,7 @@ LIMIT_FILE = Path(__file__).resolve().parents[2] / "bench" / "results" / "forced
 # boundary of the linear level, per case of `cases` ('away': 2457 N, measured between 2400 N,
 # err 0.96 %, and 3200 N, err 1.66 %; 'near': 37.0 N, between 32 N, 0.98 %, and 40 N,
 # 1.01 %). From the committed run of bench/forced_nonlinear.py
-# (bench/results/forced_linear_limit.json; tests/test_forced.py holds the two equal and
+# (bench/results/forced_linear_limit.json; tests/cli/test_forced.py holds the two equal and
 # brackets each limit); docs/forced.md gives the evidence.
 LINEAR_LIMIT = {
     "away": {"c": 1.7076741252670077e-09, "order": 1.9997807431819703, "a_1percent": 2457.025350187822},
@@ -174,7 +174,7 @@ class ReducedState(generic.ReducedState):
     """The full 11-coordinate state about the relative equilibrium of one set
     (gyro.analyses.motion.ReducedState): gamma3's rate from the integral C r2 = H (2.3), the
     emitted `cyclic_rates`, bit for bit the rate the frames (1.2)-(1.6) give (it replaced
-    their hand-typed form here; tests/test_torsion_motion.py); k3 gamma3's index."""
+    their hand-typed form here; tests/methods/test_torsion_motion.py); k3 gamma3's index."""
 
     def __init__(self, model: Model, values: dict):
         if model.name != MODEL:

@@ -6,7 +6,7 @@ Hand computation: the equation of motion m x'' = -k x^3 - F holds still where
 k x^3 = -F, x_e = -(F/k)^(1/3); about it K = 3 k x_e^2 = 3 k^(1/3) F^(2/3), so the one root
 pair is +-i omega with omega = sqrt(3 k^(1/3) F^(2/3) / m). At the defaults (m = 2 kg,
 k = 8 N/m^3, F = 1 N): x_e = -0.5 m, K = 6 N/m, omega = sqrt(3) rad/s.
-A test model of tests/test_rightmodel.py, not a model of a paper.
+A test model of tests/methods/test_rightmodel.py, not a model of a paper.
 """
 from __future__ import annotations
 

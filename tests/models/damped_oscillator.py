@@ -2,7 +2,7 @@
 
 Textbook answer: the roots of m p^2 + c p + k are p = -c/(2m) +- i sqrt(k/m - c^2/(4m^2));
 the operator is M = m, D = c (all dissipative: D_s = c, G = 0), K = k. A test model of
-tests/test_textbook.py, not a model of a paper.
+tests/generated/test_textbook.py, not a model of a paper.
 """
 from __future__ import annotations
 

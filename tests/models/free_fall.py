@@ -3,7 +3,7 @@
 Hand computation: the equation of motion m x'' = -m g has no point of rest for g != 0 (the
 residual of the equilibrium equation is -m g wherever x is), so there is no equilibrium and
 no operator about one to take frequencies of. At g = 0 every x is one (K = 0: a free
-coordinate). A test model of tests/test_rightmodel.py, not a model of a paper.
+coordinate). A test model of tests/methods/test_rightmodel.py, not a model of a paper.
 """
 from __future__ import annotations
 

@@ -8,7 +8,7 @@ equations about the hanging equilibrium solved exactly with its correction as es
 Inertia A (equatorial, about the fixed point) and C (polar), mass m at l below the fixed
 point: T = A/2 (w1^2 + w2^2) + C/2 (w3 + psi')^2 with w the tilted frame's rate, V = -m g l
 (the height of the mass centre); the linearised tilts obey A a'' + H b' + m g l a = 0,
-A b'' - H a' + m g l b = 0 (tests/test_motion_generic.py)."""
+A b'' - H a' + m g l b = 0 (tests/cli/test_motion_generic.py)."""
 from __future__ import annotations
 
 import sympy as sp

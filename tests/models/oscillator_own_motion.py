@@ -4,7 +4,7 @@ initial conditions x0, v0 taken as --set, in this same file (simulate_command, I
 simulate_command(model, args, cli) gets the parsed arguments and the command line's checks:
 cli.sets, cli.times, cli.method(args, known, default), cli.png(out), cli.perturb_items.
 Written outside the package: the runtime reaches the module only through the declaration
-(tests/test_motion_generic.py)."""
+(tests/cli/test_motion_generic.py)."""
 from __future__ import annotations
 
 import numpy as np

@@ -3,7 +3,7 @@ angles q1, q2, q3, generalised speeds u1, u2, u3 that are the body's angular-vel
 components (not the angles' rates), the kinematic differential equations u_i - w . b_i = 0
 (kd_eqs), the Lagrangian from sympy.physics.mechanics.Lagrangian in those speeds.
 
-With `kinematics` the machinery derives in the speeds (tests/test_speeds.py holds it to
+With `kinematics` the machinery derives in the speeds (tests/generated/test_speeds.py holds it to
 KanesMethod); `build_without_kinematics()` hands the same speeds over as if they were the
 angles' rates, which the machinery must refuse (the angular velocity of B, set in u, is not
 the one its orientation gives with u = q')."""

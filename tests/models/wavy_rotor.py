@@ -4,7 +4,7 @@ and y. Written outside the package, it declares its spin angle (`spin` "angle": 
 with the momentum Ip Omega), so that `gyro forced` drives it at multiples k Omega of the
 spin: by hand, m x'' + c x' + kx x = a sin(k Omega t + p) has the steady response
 x = a/|kx - m w^2 + i c w| sin(w t + p - atan2(c w, kx - m w^2)), w = k Omega, y at rest
-(tests/test_forced_generic.py)."""
+(tests/cli/test_forced_generic.py)."""
 from __future__ import annotations
 
 import sympy as sp

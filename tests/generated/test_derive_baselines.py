@@ -11,7 +11,7 @@ import pytest
 
 from bench import derive_baselines as db
 
-RECORD = Path(__file__).resolve().parent.parent / "bench" / "results" / "derive_baselines.json"
+RECORD = Path(__file__).resolve().parents[2] / "bench" / "results" / "derive_baselines.json"
 
 
 @pytest.fixture(scope="module")

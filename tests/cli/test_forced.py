@@ -376,7 +376,7 @@ def test_the_linear_levels_bound_holds_on_held_out_sets_of_the_spread():
     group's largest step), and the committed map says what the bench measured."""
     from gyro.analyses.scene import level_error
 
-    d = json.loads((Path(__file__).resolve().parents[1] / "bench" / "results" / "forced_levels.json").read_text())
+    d = json.loads((Path(__file__).resolve().parents[2] / "bench" / "results" / "forced_levels.json").read_text())
     assert d["min_bound_over_error_per_coordinate"] >= 1.0 and d["points"] == 143
     rng = np.random.default_rng(2026)
     checked = 0

@@ -141,7 +141,7 @@ def valid_lines(tmp):
             out += ["--set", f"{p.name}={v!r}"]
         return out
 
-    from tests.test_ghc_cli import LAB
+    from tests.cli.test_ghc_cli import LAB
 
     def lab_sets():
         v = dict(LAB)
@@ -306,7 +306,7 @@ def test_valid_input_is_answered_or_fails_numerically_never_refused(tmp_path):
         # valid input is answered; the exceptions are a paper formula outside its domain
         # (a square root of a negative number at far-off parameters) and a degenerate set at
         # which no point balances the equilibrium equations (gyro.equilibrium's residual
-        # test: g = 0 with a torsion stiffness of 1e-9, tests/test_rightmodel.py): exit 1,
+        # test: g = 0 with a torsion stiffness of 1e-9, tests/methods/test_rightmodel.py): exit 1,
         # one line naming the residual
         formulas = "--method" in argv and argv[argv.index("--method") + 1] == "formulas"
         unbalanced = err.startswith("gyro: error: no equilibrium found:") and "keeps a residual" in err

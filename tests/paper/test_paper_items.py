@@ -1,4 +1,4 @@
-"""Printed items of Bashirov (1983, seed 003) that tests/test_paper.py, test_anchors.py and
+"""Printed items of Bashirov (1983, seed 003) that tests/paper/test_paper.py, test_anchors.py and
 test_derivation.py did not yet assert: the right-hand side of (2.4), the size of the
 equilibrium angles, Delta2 and (3.3), the algebra of section 3 ((3.12)-(3.23), (3.25),
 (3.27)), the K0 -> oo limit of (3.26), the remark on a < b, and the search for a single
@@ -15,7 +15,7 @@ import sympy as sp
 
 from derive.models import torsion_gyrocompass as tg
 from gyro.equilibrium import equilibrium
-from tests.test_paper import MODEL, NAMES, exact, formulas, quartic_roots, rel
+from tests.paper.test_paper import MODEL, NAMES, exact, formulas, quartic_roots, rel
 
 RED = MODEL.meta["reduced"]  # x1, x3, gamma, mu, x2, gamma1, gamma2, alpha, beta, lam
 
@@ -528,7 +528,7 @@ def _scan(name, lo=0.8, hi=1.2):
 
 def test_no_single_parameter_gives_both_51_977_and_356_42():
     """The printed (3.26) values 51.977 (omega8) and 356.42 (omega9) are not reproduced: the
-    formulas give 51.982 and 356.495 (tests/test_paper.py). No single parameter moved by up
+    formulas give 51.982 and 356.495 (tests/paper/test_paper.py). No single parameter moved by up
     to +-20 % gives both to the printed digits: where omega9 rounds to 356.42 (found for A,
     I3, K_gamma, H), omega8 does not round to 51.977. (K_gamma: omega_y = 559.884 gives
     356.42 but 51.972; 51.977 needs 559.94, where omega9 = 356.46.) Omega = 3769.5, which reproduces 3851.28 and

@@ -198,7 +198,7 @@ def test_tornado_chart(nominal, tmp_path):
 
 def test_the_emitted_jacobians_numpy_and_c(tg, nominal):
     """operator_sensitivity through NumPy and the compiled C, the two the runtime calls (its
-    documented call order: params, qe; tests/test_generated.py takes every emitted function
+    documented call order: params, qe; tests/generated/test_generated.py takes every emitted function
     through all four backends against the symbolic result) at the paper's set and a moved
     one: they agree to rounding (1e-12 of each row's largest entry),
     and the Jacobian of M, D, K is that of central differences of the emitted operator

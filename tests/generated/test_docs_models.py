@@ -17,7 +17,7 @@ The page writes its output folder as /tmp/pendulum; the test replaces that strin
 everywhere in the page (commands, code and expected output), by a temporary folder, and
 compiles the C into a temporary cache ($GYRO_CACHE).
 
-`python tests/test_docs_models.py --fill` rewrites the expected outputs of the page's Python
+`python tests/generated/test_docs_models.py --fill` rewrites the expected outputs of the page's Python
 session with what it prints now (console blocks are updated by hand): run the shell blocks
 into /tmp/pendulum first. For updating the guide, never in a test.
 """
@@ -31,7 +31,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 DOC = ROOT / "docs" / "models.md"
 EXAMPLE = ROOT / "docs" / "examples" / "damped_pendulum.py"
 PLACEHOLDER = "/tmp/pendulum"  # the page's output folder

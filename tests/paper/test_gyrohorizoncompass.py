@@ -18,7 +18,7 @@ import sympy as sp
 from derive import names
 from derive.models import gyrohorizoncompass as ghc
 
-ROOT = __import__("pathlib").Path(__file__).resolve().parent.parent
+ROOT = __import__("pathlib").Path(__file__).resolve().parents[2]
 q, qd, qdd = ghc.q, ghc.qd, ghc.qdd
 A, B, C, J, L, I, nu, zeta, eta, lam = (p.symbol for p in ghc.PARAMETERS)
 theta, chi = ghc.theta, ghc.chi

@@ -232,7 +232,7 @@ def test_nutation_estimate_is_exceeded_far_from_the_example():
 
 def test_estimate_of_3_9_holds_where_delta6_squared_does_not():
     """(3.9) is the series of the pendulum root of det J''(p) in g to second order (its
-    second term is the derived z2, asserted in tests/test_derivation.py). With a long
+    second term is the derived z2, asserted in tests/generated/test_derivation.py). With a long
     torsion bar (l = 0.5 m) delta6^2 underestimates its error by 1.6x. The omitted term
     g^3 z3 relative to omega^2 is twice the relative error it causes, as for (3.4): the
     error is 0.4..0.6 of it, and within the estimate (that term plus delta6^2)."""

@@ -1,6 +1,6 @@
 """The heavy gyroscope in a gimbal (Avdonin 1969, seed 000) on the generic pipeline: its
 equations (1.1), first integrals (1.2), Routh's modified force function and the stability
-test (3.3). The emitted code is checked with every model in tests/test_generated.py."""
+test (3.3). The emitted code is checked with every model in tests/generated/test_generated.py."""
 from __future__ import annotations
 
 import numpy as np

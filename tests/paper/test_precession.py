@@ -15,7 +15,7 @@ import sympy as sp
 from derive.models import gimbal_precession as gp
 from gyro.systems import gimbal_precession as pr
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 BENCH = json.loads((ROOT / "bench" / "results" / "precession.json").read_text())
 
 

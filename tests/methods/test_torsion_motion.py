@@ -176,7 +176,7 @@ def test_the_committed_map_holds_the_bound_and_shows_its_cap(tg):
     cap is needed), the map's run of the current declarations."""
     from pathlib import Path
 
-    d = json.loads((Path(__file__).resolve().parents[1] / "bench" / "results" / "levels.json").read_text())
+    d = json.loads((Path(__file__).resolve().parents[2] / "bench" / "results" / "levels.json").read_text())
     m = d["torsion_motion_map"]
     assert m["held"] and m["max_error_over_bound_resolved"] < 1.0
     assert m["cap"] == tm.CAP

@@ -244,7 +244,7 @@ def test_cli_contract_boundary_keys(tmp_path):
     assert np.array(d["boundary"]).tolist() == [[False] * 3, [True, True, False], [False] * 3]
     assert np.array(d["values"])[1].tolist() == [-1, -1, 0]  # theta = 0.3 on the row: certainly unstable
     # (the torsion gyrocompass's boundary at the pole, phi = 90, needs the 40-digit rung, 4 s:
-    # tests/test_ladder.py::test_default_escalates_at_the_pole_where_omega1_is_rounding)
+    # tests/methods/test_ladder.py::test_default_escalates_at_the_pole_where_omega1_is_rounding)
     rc, out, err = run_cli("stability-map", "torsion_gyrocompass", "--x", "phi", "--x-range", "60", "80",
                            "--y", "u", "--y-range", "0", "1e-4", "--points", "2", "--out", str(tmp_path / "s.png"),
                            "--json", "--quiet")

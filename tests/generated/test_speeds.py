@@ -7,7 +7,7 @@ The heavy top in body-rate speeds (tests/models/top_body_speeds.py) against Kane
 mass matrix and forcing in the speeds at random points to 30 digits (RTOL 1e-25 of the
 largest entry: exact rational inputs, 30-digit evaluation of two expressions of a few
 hundred operations); the emitted functions through every backend against the symbolic
-expressions at 1e-12 (tests/test_textbook.py's tolerance). Read as rates without the
+expressions at 1e-12 (tests/generated/test_textbook.py's tolerance). Read as rates without the
 kinematic equations the same speeds would give another top (M = diag(A + m l^2, A + m l^2,
 C) everywhere): refused in one line."""
 from __future__ import annotations
@@ -24,7 +24,7 @@ import sympy as sp
 
 from derive import pipeline
 from derive.model import Unsupported
-from tests.test_textbook import MODELS, _finish, check_symbolic
+from tests.generated.test_textbook import MODELS, _finish, check_symbolic
 
 
 def _load(name="top_body_speeds"):

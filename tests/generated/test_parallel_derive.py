@@ -163,7 +163,7 @@ def test_two_jobs_write_the_bytes_of_one_job(tmp_path):
 def test_a_failure_in_a_worker_is_one_line_and_exit_2(tmp_path):
     """A model that builds but whose derivation is refused (a force on a cyclic coordinate),
     beside one that derives: exit 2, the refusal in one line naming the model, no traceback."""
-    from tests.test_machinery import MODEL_FILE, _write_model
+    from tests.unit.test_machinery import MODEL_FILE, _write_model
 
     (tmp_path / "good").mkdir()
     bad = _write_model(tmp_path / "wheel_cart.py", MODEL_FILE.format(name="wheel_cart", momentum="0"))
@@ -183,7 +183,7 @@ def test_a_model_worker_killed_is_one_line_and_exit_2(tmp_path):
     """A model whose derivation kills its own process (an identity that sends itself
     SIGKILL), beside one that derives, with --jobs 2: one line naming what happened, exit 2,
     no traceback, within a bound."""
-    from tests.test_model_namespace import PARALLEL, SERIES, _folder
+    from tests.unit.test_model_namespace import PARALLEL, SERIES, _folder
 
     good = _folder(tmp_path, "a", "series", SERIES, "two in series")
     bad = _folder(tmp_path, "b", "parallel", PARALLEL, "two in parallel")
@@ -204,7 +204,7 @@ def test_two_models_of_one_name_leave_the_last_named_with_two_jobs(tmp_path):
     written side by side into it; the one named last is what the folder holds, as with one
     job."""
     from derive import emit
-    from tests.test_model_namespace import chains
+    from tests.unit.test_model_namespace import chains
 
     files = chains(tmp_path)
     for order in (files, files[::-1]):

@@ -7,7 +7,7 @@ Max, Min) reach the nonlinear equations and every backend; the linearisation whe
 not differentiable is refused in one line. Every broken model is one line, exit 2.
 
 Tolerances: the backends are compared with the symbolic expressions evaluated by mpmath at
-30 digits, to RTOL = 1e-12 of the largest entry, as in tests/test_textbook.py (a few dozen
+30 digits, to RTOL = 1e-12 of the largest entry, as in tests/generated/test_textbook.py (a few dozen
 operations on inputs of order one: rounding is ~1e-14)."""
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ import pytest
 import sympy as sp
 
 from derive import pipeline
-from tests.test_textbook import BACKENDS, MODELS, _finish, assert_close, call, check_symbolic
+from tests.generated.test_textbook import BACKENDS, MODELS, _finish, assert_close, call, check_symbolic
 
 def _derive(name):
     from derive.__main__ import build, load_file

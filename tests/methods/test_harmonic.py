@@ -132,7 +132,7 @@ def test_bad_inputs_are_refused_naming_them():
 
 @pytest.fixture(scope="module")
 def chain(tmp_path_factory):
-    """The chain as tests/test_textbook.py builds it (shared with it within one session)."""
+    """The chain as tests/generated/test_textbook.py builds it (shared with it within one session)."""
     from test_textbook import _BUILT, emit_in_process  # the module pytest collects (tests/ on sys.path)
 
     if "driven_chain" not in _BUILT:
@@ -141,7 +141,7 @@ def chain(tmp_path_factory):
 
 
 def test_driven_chain_against_its_closed_form_and_unbalance(chain):
-    """The driven chain of tests/test_textbook.py (three masses, springs, dampers c, the force
+    """The driven chain of tests/generated/test_textbook.py (three masses, springs, dampers c, the force
     F on the third): X = (K - w^2 M + i w c I)^-1 e3 F0 with the hand-typed matrices, over a
     batch of frequencies through the resonances (cond < 1e4 with c = 0.5, so the two solves
     agree to 1e4 eps ~ 2e-12 of |X|; 1e-10 asserted). Undamped, at a natural frequency, the

@@ -59,7 +59,7 @@ def test_a_base_that_is_no_closed_form_is_refused_in_one_line():
 
 
 def test_image_and_rigorous_give_the_same_motion_on_a_turning_ship_to_1e_10():
-    """As on a constant base (tests/test_precession.py): every moment on, the base rolling,
+    """As on a constant base (tests/paper/test_precession.py): every moment on, the base rolling,
     pitching and yawing. Their difference is the integrators' error: measured 1.0e-10,
     1.1e-11, 1.1e-12 of the motion at rtol 1e-12, 1e-13, 1e-14 (on the constant base 9e-13
     at 1e-12: the ship's faster motion costs the integrator accuracy at a given rtol), so

@@ -4,7 +4,7 @@ two multipliers; their augmented equations are LagrangesMethod's, and the linear
 the crank angle at an equilibrium on the loop gives linearize()'s A and B. Compared at 30
 digits (RTOL 1e-20 of the largest entry: inputs exact to 30 digits, a few thousand
 operations, and the equilibrium found to 1e-28 by mpmath.findroot). A constraint linear in
-a coordinate is still eliminated (tests/test_mechanics_style.py's rolling disc), and a
+a coordinate is still eliminated (tests/generated/test_mechanics_style.py's rolling disc), and a
 nonholonomic constraint is refused before any constraint is solved."""
 from __future__ import annotations
 
@@ -19,8 +19,8 @@ import sympy as sp
 
 from derive import pipeline
 from derive.model import Unsupported
-from tests.test_mechanics_style import _plain
-from tests.test_textbook import MODELS
+from tests.generated.test_mechanics_style import _plain
+from tests.generated.test_textbook import MODELS
 
 RTOL = 1e-20
 STARTS = {"four_bar": [0.9, 0.3, 1.9], "slider_crank": [1.2, 0.3, 0.45]}

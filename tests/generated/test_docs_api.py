@@ -9,7 +9,7 @@ import subprocess
 import sys
 
 from tests.conftest import ROOT
-from tests.test_docs_models import blocks, expected_pattern, shell_session
+from tests.generated.test_docs_models import blocks, expected_pattern, shell_session
 
 DOC = ROOT / "docs" / "api.md"
 NOTEBOOK = ROOT / "examples" / "gyrocompass.ipynb"

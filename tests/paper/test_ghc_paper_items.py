@@ -1,5 +1,5 @@
 """Paper 001 (Zavozin 1979, the gyrohorizoncompass), the printed items that
-tests/test_gyrohorizoncompass.py and tests/test_ghc_cli.py do not already check: the passage
+tests/paper/test_gyrohorizoncompass.py and tests/cli/test_ghc_cli.py do not already check: the passage
 (1.4) -> (1.5), the rest of (1.3), the angle rates of omega2, the accuracy claim for the
 gravity moment, the two gyroscopes behind (1.6), the reading epsilon -> epsilon' in (2.2),
 epsilon0 != 0, and the printed (4.3) against the corrected one on both sides.
@@ -167,7 +167,7 @@ def test_1_6_is_the_difference_of_the_two_gyroscopes_equations():
 
 def test_2_2_multiplies_1_6_by_epsilon_dot_not_epsilon():
     """(2.2): "multiply (1.6) by epsilon" reads epsilon'. dE/dt = omega2.(1.5) + eps' (1.6)
-    identically (tests/test_gyrohorizoncompass.py::test_E_is_an_integral_symbolically), so
+    identically (tests/paper/test_gyrohorizoncompass.py::test_E_is_an_integral_symbolically), so
     with eps instead the residual is (eps' - eps) (1.6), which is not zero off the equations:
     (1.6) at a state at rest with epsilon off epsilon0 is the sensor's moment, not 0."""
     _, eq16 = ghc.printed_equations()

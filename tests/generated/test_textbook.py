@@ -35,8 +35,8 @@ import sympy as sp
 from derive import emit, pipeline
 from derive.model import TIME
 
-ROOT = Path(__file__).resolve().parent.parent
-MODELS = Path(__file__).resolve().parent / "models"
+ROOT = Path(__file__).resolve().parents[2]
+MODELS = Path(__file__).resolve().parents[1] / "models"
 RTOL = 1e-12
 BACKENDS = ("c", "numpy", "casadi", "mpmath")
 N_POINTS = 4  # random points per check (each point goes through all four backends)

@@ -8,7 +8,7 @@ Why refused rather than derived: the unbalance's term in explicit time is a forc
 cos W t on x): the rotor's reference is then no equilibrium at any instant, so none of the
 runtime's analyses (each an operator about an equilibrium) has a model to work on; the
 harmonic response of such a forcing is `gyro unbalance` on two force inputs, which gives it
-exactly (tests/test_anymodel.py checks it against the complex 4x4 solve). A time-dependent
+exactly (tests/methods/test_anymodel.py checks it against the complex 4x4 solve). A time-dependent
 operator about an equilibrium that exists (the Mathieu pendulum: a parametric excitation)
 still derives, and the runtime refuses it in one line, exit 2, naming what it would need.
 """
@@ -25,7 +25,7 @@ from derive.__main__ import build, load_file
 from derive.model import Unsupported
 from tests.conftest import run_cli
 
-MODELS = Path(__file__).resolve().parent / "models"
+MODELS = Path(__file__).resolve().parents[1] / "models"
 HOW = r"two force inputs .*gyro unbalance MODEL --force-x Fx --force-y Fy --magnitude ME"
 
 

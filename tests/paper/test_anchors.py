@@ -20,8 +20,8 @@ import pytest
 
 from gyro import ladder
 from gyro.ladder import natural_frequencies
-from tests.test_paper import MODEL, exact, formulas, rel
-FIXTURE = Path(__file__).resolve().parent / "fixtures" / "anchor_frequencies.json"
+from tests.paper.test_paper import MODEL, exact, formulas, rel
+FIXTURE = Path(__file__).resolve().parents[1] / "fixtures" / "anchor_frequencies.json"
 DATA = json.loads(FIXTURE.read_text())
 SETS = {s["name"]: s for s in DATA["sets"]}
 

@@ -166,8 +166,8 @@ ISOTROPIC = ("--set", "Omega=0", "--set", "ky1=1e6", "--set", "ky2=1e6")
 
 
 def rotor_hand_roots(**over):
-    """The rotor's roots from its closed form (tests/test_anymodel.py), Im > 0, by |lambda|."""
-    from tests.test_anymodel import closed_form, exact_roots
+    """The rotor's roots from its closed form (tests/methods/test_anymodel.py), Im > 0, by |lambda|."""
+    from tests.methods.test_anymodel import closed_form, exact_roots
 
     model = load(ROTOR)
     return exact_roots(*closed_form(model.parameters(over)))
@@ -179,7 +179,7 @@ def test_damped_isotropic_rotor_at_rest_is_stable_not_boundary(method):
     Re <= -12.7 1/s. A double root well inside the left half-plane cannot change the
     verdict: 'stable' (it was 'boundary: roots 1 and 2 merge'); no equilibrium coordinate:
     the reference method answers (it raised IndexError). The roots are the closed form's,
-    within 1e-10 (tests/test_anymodel.py's argument: LAPACK on an 8x8 companion matrix)."""
+    within 1e-10 (tests/methods/test_anymodel.py's argument: LAPACK on an 8x8 companion matrix)."""
     rc, out, err = run_cli("frequencies", ROTOR, *ISOTROPIC, "--method", method, "--json")
     assert rc == 0, err
     doc = json.loads(out)
@@ -279,7 +279,7 @@ def test_stability_map_of_the_top_is_maievski_with_one_growing_mode(tmp_path):
 def test_no_method_raises_at_a_double_root(method):
     """Every rung at the isotropic rotor's double roots (no equilibrium coordinates) and at
     the top's collision: an answer, exit 0, each root of the rotor within ten times its own
-    bound of the closed form (a first-order bound, as tests/test_anymodel.py allows) or a
+    bound of the closed form (a first-order bound, as tests/methods/test_anymodel.py allows) or a
     verdict that claims nothing ('unknown'); the top's collision a boundary or no verdict,
     never 'stable' or 'unstable'."""
     rc, out, err = run_cli("frequencies", ROTOR, *ISOTROPIC, "--method", method, "--json")

@@ -83,8 +83,11 @@ def module_constants(folder, wanted: tuple) -> dict:
         consts = {}
         for node in ast.parse((Path(folder) / f"{m.name}.py").read_text()).body:
             if isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name):
-                if node.targets[0].id in wanted and isinstance(node.value, ast.Constant):
-                    consts[node.targets[0].id] = node.value.value
+                if node.targets[0].id in wanted:
+                    try:  # a constant, or a literal of constants (a question's OPTIONS)
+                        consts[node.targets[0].id] = ast.literal_eval(node.value)
+                    except ValueError:
+                        pass
         out[m.name] = consts
     return out
 def cache_dir() -> Path:

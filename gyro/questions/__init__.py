@@ -27,6 +27,11 @@ A question module has NAME (the command line's name) and:
   what the certificates of the levels a set tries share (made once per set), an object
   with `take(rows)` whose view certify gets as `data=`.
 
+- optionally OPTIONS: {flag: help} of the command-line options it takes (`gyro scene`
+  registers every question's and refuses one the question asked does not take), and
+  `options(model, P, tol, given, initial) -> opts`: `given` {flag: text} parsed and checked
+  (ParameterError naming the flag), with `initial` the question's own inputs given.
+
 `names()` reads NAME from the sources (no NumPy); `get(name)` imports one.
 """
 from __future__ import annotations

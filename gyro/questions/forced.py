@@ -31,9 +31,21 @@ from gyro.questions import Answer, evaluator_module, unknown_kind
 
 NAME = "forced"
 VALUES = "amplitudes"  # the JSON key of the per-quantity answer (the scene table shows it)
+OPTIONS = {"harmonic": ("S:K:AMP[:PHASE]", "forced: one harmonic of the spin angle f_S = AMP sin(K omega_c t + "
+                                           "PHASE), as gyro forced takes it (required)")}
 SAFETY = 2.0  # the linear level's estimate: this many times harmonic balance's first step
 ESTIMATE_NONLINEAR = 1e-8  # harmonic balance against the shooting: 4.4e-9 at most, measured
 EPS = np.finfo(float).eps
+
+
+def options(model, P, tol: float, given: dict, initial: dict) -> dict:
+    """--harmonic S:K:AMP[:PHASE], required, S among the model's harmonic inputs."""
+    from gyro.analyses.forced import parse_harmonic
+    from gyro.analyses.spin import harmonic_inputs
+
+    if given.get("harmonic") is None:
+        raise ParameterError("--harmonic: the forced question needs one harmonic S:K:AMP[:PHASE]")
+    return {"harmonic": parse_harmonic(given["harmonic"], len(harmonic_inputs(model)[1]))}
 
 
 def quantities(model, opts) -> list[str]:

@@ -20,6 +20,21 @@ EPS = np.finfo(float).eps
 
 NAME = "frequencies"
 VALUES = "frequencies"  # the JSON key of the per-quantity answer (the scene table shows it)
+OPTIONS = {"modes": ("I,J,...", "frequencies: only these modes (1 = the slowest)")}
+
+
+def options(model, P, tol: float, given: dict, initial: dict) -> dict:
+    """--modes I,J,... as a list of mode numbers (1 = the slowest), or None for all."""
+    text = given.get("modes")
+    if text is None:
+        return {"modes": None}
+    try:
+        modes = [int(t) for t in text.split(",")]
+    except ValueError:
+        from gyro.errors import ParameterError
+
+        raise ParameterError(f"--modes {text!r}: expected mode numbers I,J,... (1 = the slowest)") from None
+    return {"modes": modes}
 
 
 def quantities(model, opts) -> list[str]:

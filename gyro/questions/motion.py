@@ -28,6 +28,46 @@ from gyro.questions import Answer, evaluator_module, unknown_kind
 NAME = "motion"
 POINTS = 201  # sample times over the horizon
 DEFAULT_HORIZON = 1.0  # s
+OPTIONS = {"horizon": ("T", "motion: the time span in s (also --t-end)")}
+EPS = 2.220446049250313e-16  # a double's relative rounding: no answer printed as one is closer
+MAX_PERIODS = 10_000  # of the fastest motion over a motion's horizon (a linear motion level of
+# the papers' models: 350 periods of omega4 = 219.6 rad/s in 6 s, 3500 in 28 s, measured)
+
+
+def options(model, P, tol: float, given: dict, initial: dict) -> dict:
+    """--horizon T, positive; refused at once: a tolerance below a double's rounding (every
+    level of a motion integrates in doubles: 38 s at 1e-30 before, then no answer), and a
+    horizon of more than MAX_PERIODS periods of the fastest motion (--horizon 1e6: 52-77 s
+    before)."""
+    from gyro.errors import ParameterError, finite_number
+
+    if tol < EPS:
+        raise ParameterError(f"--tol {tol:g}: below a double's rounding ({EPS:.2g}), which bounds every "
+                             "level of a motion (each integrates in doubles)")
+    if given.get("horizon") is None:
+        return {}
+    horizon = finite_number("--horizon", given["horizon"])
+    if not horizon > 0:
+        raise ParameterError(f"--horizon: must be positive, got {given['horizon']!r}")
+    extra = initial_conditions(model)
+    w = _fastest(model, P, {**{k: d[1] for k, d in extra.items()}, **initial}, extra)
+    periods = horizon * w / (2 * np.pi)
+    if periods > MAX_PERIODS:
+        raise ParameterError(f"--horizon {horizon:g}: {periods:.3g} periods of the fastest motion ({w:.4g} rad/s), "
+                             f"over the {MAX_PERIODS} a motion question takes; a shorter horizon")
+    return {"horizon": horizon}
+
+
+def _fastest(model, P, initial: dict, extra: dict) -> float:
+    """The fastest rate of the motion in rad/s: the largest natural frequency about the
+    equilibrium (a model that has one) and the largest initial rate given in rad/s."""
+    rates = [abs(v) for k, v in initial.items() if extra[k][0] == "rad/s"]
+    if not model.meta.get("momenta"):
+        from gyro import ladder
+
+        w = ladder.spectrum(model, P, "default").frequencies[0]
+        rates += [float(np.max(w))] if np.all(np.isfinite(w)) else []
+    return max(rates, default=0.0)
 
 
 def _analysis(level, model):

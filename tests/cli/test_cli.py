@@ -7,7 +7,7 @@ import sys
 
 import pytest
 
-from tests.conftest import ROOT
+from tests.conftest import ROOT, error_lines, run_cli
 
 NAMES = "m M l l1 l2 A C I1 I2 I3 K0 Kp Kgamma H u phi g h cp c0 cgamma".split()
 
@@ -138,3 +138,22 @@ def test_found_in_review_cli(tmp_path):
     r = gyro("frequencies", "torsion_gyrocompass", "--method", "formulas", "--json")
     assert json.loads(r.stdout)["stability"]["class"] == "unknown"
     assert callable(gyro_main)
+
+
+def test_scene_takes_each_questions_own_options_and_refuses_the_others():
+    """gyro scene registers the options each question declares (OPTIONS) and refuses, in one
+    line naming what the question takes, one that the question asked does not take; its
+    source names no question."""
+    from gyro.cli import scene
+
+    assert set(scene._question_options()) == {"modes", "horizon", "harmonic"}
+    source = (ROOT / "gyro" / "cli" / "scene.py").read_text()
+    assert not [q for q in ("frequencies", "motion", "forced", "stability") if f'"{q}"' in source]
+    for args, says in ((["frequencies", "--horizon", "2"], "--horizon: not an option of the frequencies question "
+                                                            "(it takes --modes)"),
+                       (["stability", "--modes", "1"], "--modes: not an option of the stability question (it takes "
+                                                       "none)"),
+                       (["motion", "--harmonic", "1:1:1"], "--harmonic: not an option of the motion question (it "
+                                                           "takes --horizon)")):
+        rc, out, err = run_cli("scene", "torsion_gyrocompass", args[0], "--tol", "1e-3", *args[1:])
+        assert rc == 2 and out == "" and error_lines(err) == [f"gyro: error: {says}"], err

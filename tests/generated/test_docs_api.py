@@ -17,7 +17,7 @@ NOTEBOOK = ROOT / "examples" / "gyrocompass.ipynb"
 
 def test_the_api_page_runs_as_written(tmp_path):
     env = dict(os.environ, GYRO_CACHE=str(tmp_path / "cache"))
-    proc = subprocess.run([sys.executable, str(ROOT / "tests" / "test_docs_models.py"), "--run", str(tmp_path), str(DOC)],
+    proc = subprocess.run([sys.executable, str(ROOT / "tests" / "generated" / "test_docs_models.py"), "--run", str(tmp_path), str(DOC)],
                           cwd=ROOT, env=env, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stdout[-4000:] + proc.stderr[-2000:]
 

@@ -504,11 +504,26 @@ def block_starts(model: Model, M, D, K, good):
     return herm, w[fine], z[fine]
 
 
+EIGENVECTOR_CHUNK = 2048  # sets per pass: J(lambda) of every root is (sets, r, n, n) complex
+
+
 def eigenvectors(M, D, K, lam) -> np.ndarray:
     """Right eigenvectors x of J(lambda) x = 0 for a batch: M, D, K (B, n, n), roots lam
     (B, r); x (B, r, n) the right singular vector of J(lambda) at its smallest singular value,
     of unit length, its largest component real and positive (a mode shape, in the
-    coordinates' own units). NaN where lambda is not finite."""
+    coordinates' own units). NaN where lambda is not finite. The batch is taken
+    EIGENVECTOR_CHUNK sets at a time (each set's vectors are its own): a Campbell diagram of
+    1e5 spins held 5.2 GB at once, J and its shifted copy for every root of every spin."""
+    lam = np.asarray(lam, complex)
+    B = lam.shape[0]
+    if B > EIGENVECTOR_CHUNK:
+        return np.concatenate([_eigenvectors(M[i:i + EIGENVECTOR_CHUNK], D[i:i + EIGENVECTOR_CHUNK],
+                                             K[i:i + EIGENVECTOR_CHUNK], lam[i:i + EIGENVECTOR_CHUNK])
+                               for i in range(0, B, EIGENVECTOR_CHUNK)])
+    return _eigenvectors(M, D, K, lam)
+
+
+def _eigenvectors(M, D, K, lam) -> np.ndarray:
     lam = np.asarray(lam, complex)
     good = np.isfinite(lam)
     lz = np.where(good, lam, 0.0)[..., None, None]

@@ -84,7 +84,7 @@ def tg_functions():
     return derived(MODEL)[2]
 
 
-NOTICES = ("gyro: deriving the model file", "gyro: compiling the generated C")
+NOTICES = ("gyro: deriving ", "gyro: compiling the generated C")  # models.py: _Notice, cbackend
 
 
 def error_lines(err: str) -> list[str]:

@@ -19,7 +19,7 @@ import math
 import numpy as np
 import pytest
 
-from tests.conftest import ROOT, run_cli
+from tests.conftest import ROOT, run_cli, error_lines
 
 TOP = str(ROOT / "tests" / "models" / "symmetric_top.py")
 A, C, M, G, L = 0.025, 0.01, 1.0, 10.0, 0.04  # the critical spin is 20 rad/s exactly: 4 A m g l = 0.04
@@ -137,7 +137,7 @@ def test_a_model_without_conditions_is_refused_in_one_line(cmd):
     extra = [] if cmd == "stability" else ["--x", "k=1:2:3", "--y", "m=1:2:3", "--out", "x.png"]
     path = str(ROOT / "tests" / "models" / "damped_oscillator.py")
     rc, out, err = run_cli(cmd, path, *extra)
-    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert rc == 2 and out == "" and len(error_lines(err)) == 1 and "Traceback" not in err
     assert "damped_oscillator declares no conditions (Model.conditions" in err
 
 
@@ -154,7 +154,7 @@ def test_a_model_without_conditions_is_refused_in_one_line(cmd):
 def test_bad_input_exits_2_with_one_line(args, needle, tmp_path):
     args = [str(tmp_path / a) if a == "x.png" else a for a in args]
     rc, out, err = run_cli(*args)
-    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+    assert rc == 2 and out == "" and len(error_lines(err)) == 1, err
     assert needle in err and "Traceback" not in err
     assert not (tmp_path / "x.png").exists()
 
@@ -237,10 +237,10 @@ def test_a_damped_model_any_set_decides_and_a_margin_without_a_value_is_refused(
     assert rc == 0 and d["verdict"] == "unstable" and not d["sufficient"]
     assert math.isclose(max(re for re, _ in d["eigenvalues"]), (-0.3 + math.sqrt(0.09 + 8)) / 4, rel_tol=1e-12)
     rc, out, err = run_cli("stability", str(path), "--set", "c=0")
-    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert rc == 2 and out == "" and len(error_lines(err)) == 1
     assert "the margin k - 1/c of damped_conditions is not finite" in err and "inf" not in err.replace("finite", "")
     # a declared system that is not there: refused when the model file is derived, one line
     path.write_text(DAMPED.replace('symmetric_zero=["x"],', 'symmetric_zero=["x"], system="gyro.systems.nosuch",'))
     rc, out, err = run_cli("stability", str(path))
-    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert rc == 2 and out == "" and len(error_lines(err)) == 1 and "Traceback" not in err
     assert "the declared module 'gyro.systems.nosuch' cannot be found" in err

@@ -17,6 +17,7 @@ import pytest
 
 from gyro.cli import main
 from gyro.models import load
+from tests.conftest import error_lines
 
 N_LINES = 1400
 SEED = 20261130
@@ -278,7 +279,7 @@ def _contract(argv, code, out, err, dt):
     assert "Traceback" not in err and "Traceback" not in out, where
     assert code in (0, 1, 2), f"{where}: exit {code}"
     if code:
-        assert len(err.strip().splitlines()) == 1 and err.startswith(("gyro", "usage")), f"{where}: {err!r}"
+        assert len(error_lines(err)) == 1 and error_lines(err)[0].startswith(("gyro", "usage")), f"{where}: {err!r}"
     elif "--json" in argv:
         doc = json.loads(out, parse_constant=lambda c: pytest.fail(f"{where}: {c} in the JSON"))
         # no verdict beside a non-finite frequency
@@ -313,7 +314,7 @@ def test_valid_input_is_answered_or_fails_numerically_never_refused(tmp_path):
         assert "Traceback" not in err and (code == 0 or (code == 1 and (formulas or unbalanced))), \
             f"{where}: exit {code}: {err}"
         if code:
-            assert len(err.strip().splitlines()) == 1, f"{where}: {err!r}"
+            assert len(error_lines(err)) == 1, f"{where}: {err!r}"
         elif "--json" in argv:
             json.loads(out, parse_constant=lambda c: pytest.fail(f"{where}: {c} in the JSON"))
         codes.append(code)
@@ -453,7 +454,7 @@ def _holds(argv, code, out, err, dt, tmp, scratch):
     assert "Traceback" not in err + out, f"{where}: {err}"
     assert code in (0, 1, 2), f"{where}: exit {code}"
     if code:
-        assert len(err.strip().splitlines()) == 1 and err.startswith(("gyro", "usage")), f"{where}: {err!r}"
+        assert len(error_lines(err)) == 1 and error_lines(err)[0].startswith(("gyro", "usage")), f"{where}: {err!r}"
         assert "np.float64" not in err and "__init__.py" not in err, f"{where}: {err!r}"
         assert not err.startswith(("gyro: error: omega:", "gyro: error: u:")), f"{where}: an internal name: {err!r}"
     if code == 2:
@@ -592,5 +593,5 @@ def test_a_stopped_tolerance_leaves_no_temporary_folder(tmp_path, sig, code):
     assert p.poll() is None, p.communicate()
     p.send_signal(getattr(signal, sig))
     out, err = p.communicate(timeout=60)
-    assert p.returncode == code and out == "" and len(err.strip().splitlines()) == 1, (p.returncode, err)
+    assert p.returncode == code and out == "" and len(error_lines(err)) == 1, (p.returncode, err)
     assert not any(scratch.iterdir()), sorted(scratch.iterdir())

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from gyro import ladder
-from tests.conftest import ROOT, run_cli
+from tests.conftest import ROOT, run_cli, error_lines
 
 ROTOR_FILE = ROOT / "examples" / "rigid_rotor.py"
 
@@ -86,7 +86,7 @@ def test_the_formulas_refuse_a_model_without_them_through_every_entry(rotor):
         ladder.spectrum(rotor, rotor.vector(), "formulas")
     assert "has no approximate formulas" in str(exc.value) and "\n" not in str(exc.value)
     rc, out, err = run_cli("frequencies", str(ROTOR_FILE), "--method", "formulas")
-    assert rc == 2 and "formulas" in err and len(err.strip().splitlines()) == 1
+    assert rc == 2 and "formulas" in err and len(error_lines(err)) == 1
 
 
 def gyro_error():
@@ -105,7 +105,7 @@ def test_models_from_anywhere_at_the_command_line(rotor, tmp_path):
     assert rc == 0 and "Omega" in out
     for bad, word in ((tmp_path / "none.py", "none.py"), (ROOT / "README.md", "README.md")):
         rc, out, err = run_cli("frequencies", str(bad))
-        assert rc == 2 and word in err and len(err.strip().splitlines()) == 1 and out == ""
+        assert rc == 2 and word in err and len(error_lines(err)) == 1 and out == ""
     notmodel = tmp_path / "notmodel.py"
     notmodel.write_text("x = 1\n")
     rc, out, err = run_cli("frequencies", str(notmodel))
@@ -195,7 +195,7 @@ def test_campbell_json_contract_and_bad_input(rotor, tmp_path):
                        (["--spin-range", "0", "10"], "--out")):
         extra = [] if word == "--out" else ["--json"]
         rc, out, err = run_cli("campbell", str(ROTOR_FILE), *args, *extra, "--quiet")
-        assert rc == 2 and word in err and len(err.strip().splitlines()) == 1 and out == "", (args, err)
+        assert rc == 2 and word in err and len(error_lines(err)) == 1 and out == "", (args, err)
 
 
 def test_modes_are_the_closed_forms_eigenvectors(rotor):

@@ -90,6 +90,10 @@ def start(model, P, offsets: dict) -> Start:
     return Start(q_ref, qd_ref, np.concatenate([q0, qd0]), dict(zip(eq_names, map(float, qe[0]))))
 
 
+# the linear motion's fine grid, its samples times the states at the most (some 80 MB an
+# array; 25 times the largest the error maps use: the torsion gyrocompass at 10x spin over
+# 0.05 s, 3.8e5; about 10 s of work): a horizon past it is refused, not allocated
+FINE_BUDGET = 1e7
 STEPS_PER_PERIOD = 40  # DOP853 at rtol 1e-10 on a smooth oscillation: 25-60 steps a period
 EVALUATIONS_PER_STEP = 12
 
@@ -320,13 +324,20 @@ def linear_motion(red: ReducedState, z0: np.ndarray, t, corrections: int = 2, fi
     after `corrections` steps of Picard's iteration e' = A e + r(z_L + e), e(0) = 0,
     r(z) = f(z) - A z (the terms of second and higher order, and the reference's residual
     f(0)), each the linear system driven by the remainder (Duhamel's integral, r linear
-    between the samples). `steps` is the fine grid's steps per sample interval."""
+    between the samples). `steps` is the fine grid's steps per sample interval (1 without a
+    correction: the linear motion alone is exact on the sample grid). A grid of more than
+    FINE_BUDGET samples times states stops with IntegrationBudget, before any work."""
     t = uniform_times(t)
     A = red.first_order
     n2 = A.shape[0]
     w_max = float(np.max(np.abs(np.linalg.eigvals(A))))
     h = 2 * np.pi / (2 * w_max) / fine if w_max > 0 else t[-1]
-    per = max(1, int(np.ceil((t[1] - t[0]) / h)))
+    per = max(1, int(np.ceil((t[1] - t[0]) / h))) if corrections else 1
+    size = ((t.size - 1) * per + 1) * n2
+    if not size <= FINE_BUDGET:
+        raise IntegrationBudget(f"the linear motion's correction over {t[-1]:.6g} s needs {size / n2:.3g} samples "
+                                f"({fine} per period of the remainder's fastest term, |eig|max = {w_max:.6g} 1/s), "
+                                f"over its budget of {FINE_BUDGET / n2:.3g}: a shorter horizon")
     tf = np.linspace(0.0, t[-1], (t.size - 1) * per + 1)
     Ad, B0, B1 = first_order_hold(A, tf[1] - tf[0])
     zL = propagate(Ad, np.zeros((tf.size - 1, n2)), np.asarray(z0, float))

@@ -137,6 +137,24 @@ def test_toward_the_cap_two_picard_steps_hold_where_one_is_beaten_and_the_cap_re
     assert np.all(np.isinf(ghc.motion_answer(mo, t, "linear")[1]))
 
 
+def test_a_horizon_past_the_fine_grids_budget_is_refused_before_any_work(m):
+    """The linear motion's fine grid over 1e6 s of the Earth set would be 2.2e9 samples (18 GB
+    an array): refused at once with the budget named, a failure of the level through the
+    question (the selector goes up), not an allocation."""
+    import time
+
+    from gyro import ode
+
+    red = generic.ReducedState(m, m.defaults)
+    z0 = ghc.Motion(m.defaults).perturbation
+    t0 = time.perf_counter()
+    with pytest.raises(ode.IntegrationBudget, match="a shorter horizon"):
+        generic.linear_answer(red, z0, np.linspace(0.0, 1e6, 201), ["rad"] * 4)
+    assert time.perf_counter() - t0 < 1.0
+    a = motion.answer(m, hierarchy.get(m, "linear"), m.vector()[None, :], {"horizon": 1e6})
+    assert "over its budget" in a.failed[0] and np.all(np.isinf(a.estimate))
+
+
 MAP = json.loads((ROOT / "bench" / "results" / "levels.json").read_text())["ghc_motion_error_map"]
 
 

@@ -351,7 +351,7 @@ def levels():
         Level("linear", "the terms of second and higher order in the perturbation of (3.1) in (1.5)-(1.6)",
               {"kind": "trajectory", "module": "gyro.systems.gyrohorizoncompass", "method": "linear",
                "cap_of": "displacement"},
-              {"motion": Bound(estimate=True)}, cost=0.4, reference="integrated:DOP853",
+              {"motion": Bound(estimate=True)}, cost=0.03, reference="integrated:DOP853",
               doc="the linearised equations about (3.1) solved exactly (gyro.analyses.motion); the estimate "
                   "twice the correction after two Picard steps, infinite beyond a quarter of the displacement"),
         Level("integrated", "nothing of (1.5)-(1.6) (the integrator's truncation: two tolerances compared)",

@@ -196,31 +196,6 @@ def budgeted(fun, label: str, t_end: float, max_s: float, max_steps: float, erro
     return rhs
 
 
-def correction_rhs(model: Model, P, ye, A):
-    """(t, z) -> z' for solve_ivp on z = (x, d), 2 x 2n: the linearisation x' = A x about
-    the equilibrium state ye, and beside it the first correction of the linear motion,
-    d' = A d + r(t), r = f(ye + x) - A x the remainder of the equations of motion y' = f(y)
-    along the linear motion (their terms of second and higher order in x, and f(ye), which
-    is zero but for rounding). With x(0) = x0, d(0) = 0, d(t) = int_0^t e^{A (t - s)} r(s) ds
-    is the first Picard step from the linear motion toward the motion of the full
-    equations: the linear motion's error to second order in x0. One compiled CasADi
-    Function of z at the given P, ye, A."""
-    import casadi as ca
-
-    s = symbolic(model)
-    n = s.y.numel()
-    z = ca.SX.sym("z", 2 * n)
-    x, d = z[:n], z[n:]
-    Am = ca.DM(np.asarray(A, float))
-    f = ca.substitute(ca.substitute(s.ydot, s.p, ca.DM(np.asarray(P, float))), s.y, ca.DM(np.asarray(ye, float)) + x)
-    F = ca.Function("correction", [z], [ca.vertcat(Am @ x, Am @ d + f - Am @ x)])
-
-    def rhs(t, zz):
-        return np.asarray(F(zz)).ravel()
-
-    return rhs
-
-
 def two_tolerances(run, rtol: float, finer: float = 1e-2):
     """An integrated answer and its error estimate by two tolerances (the `motion` question's
     integrated levels): run(r) -> the answer (times, columns) at relative tolerance r; the

@@ -340,17 +340,20 @@ def levels():
     """The hierarchy of the gyrohorizoncompass (docs/hierarchy.md): its linearised operator
     about the relative equilibrium (3.1)-(3.2) by the ladder's methods (their estimates are
     the bounds); and the motion of a perturbed equilibrium, by the linearised equations
-    (exact, e^{A t}; bounded by twice their first correction toward (1.5)-(1.6)) or by
+    (the generic linear level, gyro.analyses.motion: exact, e^{A t}; bounded by twice their
+    correction after two Picard steps toward (1.5)-(1.6), capped at a quarter of the linear
+    motion's displacement from (3.1), at most a radian) or by
     (1.5)-(1.6) integrated (bounded by two tolerances compared). Motion costs: s per set
     at the default motion of the Earth set over a horizon of 1 s (bench/levels.py)."""
     from derive.model import Bound, Level
 
     return [
         Level("linear", "the terms of second and higher order in the perturbation of (3.1) in (1.5)-(1.6)",
-              {"kind": "trajectory", "module": "gyro.systems.gyrohorizoncompass", "method": "linear", "rtol": 1e-6},
-              {"motion": Bound(estimate=True)}, cost=0.4, reference="integrated:DOP853",
-              doc="the linearised equations about (3.1) solved exactly (expm of the first-order matrix); "
-                  "the estimate twice the first correction, integrated at rtol 1e-6"),
+              {"kind": "trajectory", "module": "gyro.systems.gyrohorizoncompass", "method": "linear",
+               "cap_of": "displacement"},
+              {"motion": Bound(estimate=True)}, cost=0.03, reference="integrated:DOP853",
+              doc="the linearised equations about (3.1) solved exactly (gyro.analyses.motion); the estimate "
+                  "twice the correction after two Picard steps, infinite beyond a quarter of the displacement"),
         Level("integrated", "nothing of (1.5)-(1.6) (the integrator's truncation: two tolerances compared)",
               {"kind": "trajectory", "module": "gyro.systems.gyrohorizoncompass", "methods": ["DOP853", "Radau"],
                "rtol": 1e-10, "default": "DOP853"},

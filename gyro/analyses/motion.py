@@ -90,6 +90,10 @@ def start(model, P, offsets: dict) -> Start:
     return Start(q_ref, qd_ref, np.concatenate([q0, qd0]), dict(zip(eq_names, map(float, qe[0]))))
 
 
+# the linear motion's fine grid, its samples times the states at the most (some 80 MB an
+# array; 25 times the largest the error maps use: the torsion gyrocompass at 10x spin over
+# 0.05 s, 3.8e5; about 10 s of work): a horizon past it is refused, not allocated
+FINE_BUDGET = 1e7
 STEPS_PER_PERIOD = 40  # DOP853 at rtol 1e-10 on a smooth oscillation: 25-60 steps a period
 EVALUATIONS_PER_STEP = 12
 
@@ -273,32 +277,76 @@ def uniform_times(t) -> np.ndarray:
     return t
 
 
+def first_order_hold(A: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(Ad, B0, B1) of one step h of z' = A z + r with r linear over the step, in rows:
+    z(h) = z(0) Ad + r(0) B0 + r(h) B1 (the exponential of the augmented matrix, as
+    scipy.signal.lsim's interpolating hold)."""
+    from scipy.linalg import expm
+
+    n = A.shape[0]
+    M = np.zeros((3 * n, 3 * n))
+    M[:n, :n], M[:n, n:2 * n], M[n:2 * n, 2 * n:] = A * h, np.eye(n) * h, np.eye(n)
+    E = expm(M.T)
+    return E[:n, :n], E[n:2 * n, :n] - E[2 * n:, :n], E[2 * n:, :n]
+
+
+def propagate(Ad: np.ndarray, g: np.ndarray, z0: np.ndarray, chunk: int = 64) -> np.ndarray:
+    """z_{k+1} = z_k Ad + g_k (rows), k = 0 .. N - 2, from z0: (N, n). In chunks of `chunk`
+    steps: within each the response to g by one product with the powers Ad^j, the chunks'
+    starts one after another (the same recurrence as a step-by-step loop, in NumPy's
+    matrix products)."""
+    N, n = g.shape[0] + 1, z0.size
+    c = max(1, min(chunk, N - 1))
+    nc = -(-(N - 1) // c)
+    G = np.zeros((nc * c, n))
+    G[:N - 1] = g
+    P = [np.eye(n)]
+    for _ in range(c):
+        P.append(P[-1] @ Ad)
+    P = np.array(P)  # (c + 1, n, n)
+    j, i = np.nonzero(np.arange(c)[:, None] < np.arange(c + 1)[None, :])
+    T = np.zeros((c, c + 1, n, n))
+    T[j, i] = P[i - 1 - j]  # the response at step i of the chunk to g at its step j < i
+    S = (G.reshape(nc, c * n) @ T.transpose(0, 2, 1, 3).reshape(c * n, (c + 1) * n)).reshape(nc, c + 1, n)
+    X = np.empty((nc + 1, n))
+    X[0] = z0
+    for m in range(nc):
+        X[m + 1] = X[m] @ P[c] + S[m, c]
+    z = (np.einsum("mk,ikl->mil", X[:nc], P[:c]) + S[:, :c]).reshape(nc * c, n)
+    return np.vstack([z, X[nc:]])[:N]
+
+
 def linear_motion(red: ReducedState, z0: np.ndarray, t, corrections: int = 2, fine: int = 32):
     """The linear motion z' = A z from z0 and its correction at the sample times t (uniform
     from 0): (z_L, e, steps), each (times, 2n). The linear motion is propagated exactly
-    (scipy.signal.lsim: the exponential of A) over a fine grid, `fine` samples per shortest
-    period 2 pi/(2 omega_max) of the remainder's quadratic terms; e after `corrections`
-    steps of Picard's iteration e' = A e + r(z_L + e), e(0) = 0, r(z) = f(z) - A z (the
-    terms of second and higher order, and the reference's residual f(0)), each the linear
-    system driven by the remainder (Duhamel's integral, r linear between the samples).
-    `steps` is the fine grid's steps per sample interval."""
-    from scipy.signal import StateSpace, lsim
-
+    (the exponential of A, `first_order_hold` and `propagate`) over a fine grid, `fine`
+    samples per shortest period 2 pi/(2 omega_max) of the remainder's quadratic terms; e
+    after `corrections` steps of Picard's iteration e' = A e + r(z_L + e), e(0) = 0,
+    r(z) = f(z) - A z (the terms of second and higher order, and the reference's residual
+    f(0)), each the linear system driven by the remainder (Duhamel's integral, r linear
+    between the samples). `steps` is the fine grid's steps per sample interval (1 without a
+    correction: the linear motion alone is exact on the sample grid). A grid of more than
+    FINE_BUDGET samples times states stops with IntegrationBudget, before any work."""
     t = uniform_times(t)
     A = red.first_order
     n2 = A.shape[0]
     w_max = float(np.max(np.abs(np.linalg.eigvals(A))))
     h = 2 * np.pi / (2 * w_max) / fine if w_max > 0 else t[-1]
-    per = max(1, int(np.ceil((t[1] - t[0]) / h)))
+    per = max(1, int(np.ceil((t[1] - t[0]) / h))) if corrections else 1
+    size = ((t.size - 1) * per + 1) * n2
+    if not size <= FINE_BUDGET:
+        raise IntegrationBudget(f"the linear motion's correction over {t[-1]:.6g} s needs {size / n2:.3g} samples "
+                                f"({fine} per period of the remainder's fastest term, |eig|max = {w_max:.6g} 1/s), "
+                                f"over its budget of {FINE_BUDGET / n2:.3g}: a shorter horizon")
     tf = np.linspace(0.0, t[-1], (t.size - 1) * per + 1)
-    sys = StateSpace(A, np.eye(n2), np.eye(n2), np.zeros((n2, n2)))
-    zL = lsim(sys, np.zeros((tf.size, n2)), tf, X0=z0, interp=True)[2]
+    Ad, B0, B1 = first_order_hold(A, tf[1] - tf[0])
+    zL = propagate(Ad, np.zeros((tf.size - 1, n2)), np.asarray(z0, float))
     f = red.rhs.map(tf.size)
     e = np.zeros_like(zL)
     for _ in range(corrections):
         z = zL + e
         r = np.asarray(f(z.T)).T - z @ A.T
-        e = lsim(sys, r, tf, X0=np.zeros(n2), interp=True)[2]
+        e = propagate(Ad, r[:-1] @ B0 + r[1:] @ B1, np.zeros(n2))
     return zL[::per], e[::per], per
 
 
@@ -346,15 +394,28 @@ def group_max(v: np.ndarray, units: list) -> np.ndarray:
 # ----------------------------------------------------------------------------- the motion question
 # The `motion` question's levels for any model (gyro/questions/motion.py): a level declares
 # {"kind": "trajectory", "module": "gyro.analyses.motion", "method": "linear" | a SciPy
-# method, "rtol": R, "quantities": the reduced coordinates}; for_model(model) gives the
-# protocol's INITIAL, Motion and motion_answer. The constants are the torsion gyrocompass's,
-# measured there (paper 003's motion levels, docs/hierarchy.md) and checked on models
-# written outside the package (tests/cli/test_motion_generic.py).
+# method, "rtol": R, "quantities": the reduced coordinates, optionally "cap_of": one of
+# CAP_OF}; for_model(model) gives the protocol's INITIAL, Motion and motion_answer. The
+# constants are the torsion gyrocompass's, measured there (paper 003's motion levels,
+# docs/hierarchy.md), checked on paper 001's gyrohorizon compass (its error map and its joint
+# draws toward the cap, bench/levels.py) and on models written outside the package
+# (tests/cli/test_motion_generic.py).
 FACTOR = 2.0  # the bound over the correction: measured error/bound 0.50..0.55 below the cap (bench)
-# the largest estimate, over the motion's largest excursion (the question's scale), for which
-# it is a bound: measured on the torsion gyrocompass error over it 0.50..0.55 up to 0.15, 0.62
-# at 0.30, 0.77 at 0.58, 1.0 at 0.84, 2.0 at 1.3 (bench/results/levels.json 'toward_the_cap')
+# the largest estimate, over the linear motion's size (CAP_OF), for which it is a bound:
+# measured error over it on the torsion gyrocompass (over the excursion) 0.50..0.55 up to
+# 0.15, 0.62 at 0.30, 0.77 at 0.58, 1.0 at 0.84, 2.0 at 1.3; on the gyrohorizon compass (over
+# the displacement, at most a radian) at most 0.57 below 0.25, 0.70 at 0.26, 0.77 at 0.61,
+# 1.0 at 0.66 (a held-out draw 2 rad off) and 1.2 at 1.2 (bench/results/levels.json
+# 'toward_the_cap' of 'torsion_motion_map' and of 'ghc_motion_error_map')
 CAP = 0.25
+# what the cap is a fraction of (a level's declared "cap_of"): "excursion", the linear
+# motion's largest distance from its start (the default; the torsion gyrocompass's question
+# scale); "displacement", its largest distance from the reference, at most 1 (a radian of an
+# angle): the perturbation's size, which sets the remainder's relative size, for a motion
+# that hardly leaves its offset start within the horizon (the gyrohorizon compass's Earth set
+# over 2 s: its excursion a tenth of its displacement); beyond a radian an angle's terms of
+# every order are alike (docs/hierarchy.md, paper 001's levels)
+CAP_OF = ("excursion", "displacement")
 ROUNDING = 4.0  # the exponential's rounding per step, in eps of the largest |z_L|
 CORRECTIONS = 2  # Picard steps: the second holds every term of third order
 FINE = 32  # samples per shortest period 2 pi/(2 omega_max) of the remainder's quadratic terms
@@ -389,10 +450,10 @@ class _Generic:
         z0 = np.array([vals[f"{c}_0"] for c in self.reduced] + [vals[f"{c}_d0"] for c in self.reduced])
         return _Motion(self.model, dict(params), z0)
 
-    def motion_answer(self, motion, t, method: str = "linear", rtol: float = 1e-9):
+    def motion_answer(self, motion, t, method: str = "linear", rtol: float = 1e-9, cap_of: str = CAP_OF[0]):
         """The reduced coordinates q_ref + x at the times t (times, n) and an estimate of each
         one's largest absolute error over t."""
-        return motion_answer(motion.reduced, motion.z0, t, self.units, method, rtol)
+        return motion_answer(motion.reduced, motion.z0, t, self.units, method, rtol, cap_of)
 
 
 class _Motion:
@@ -404,29 +465,42 @@ class _Motion:
         return ReducedState(self.model, self.params)
 
 
-def linear_answer(red: ReducedState, z0: np.ndarray, t, units: list, cap: float = CAP):
+def linear_size(x: np.ndarray, cap_of: str = CAP_OF[0]) -> float:
+    """The size of a linear motion x (times, n: displacements from the reference) the cap
+    is a fraction of (CAP_OF)."""
+    if cap_of not in CAP_OF:
+        raise ValueError(f"cap_of {cap_of!r}: one of {', '.join(CAP_OF)}")
+    if cap_of == "excursion":
+        return float(np.max(np.sqrt(np.sum((x - x[:1]) ** 2, axis=1))))
+    return min(float(np.max(np.sqrt(np.sum(x ** 2, axis=1)))), 1.0)
+
+
+def linear_answer(red: ReducedState, z0: np.ndarray, t, units: list, cap: float = CAP, cap_of: str = CAP_OF[0]):
     """The linear level's answer: q_ref + x_L at the times t (times, n) and its estimate,
     FACTOR times the correction's largest |e| over each coordinate's unit group plus the
-    rounding, infinite where its largest exceeds `cap` of the motion's largest excursion
-    (an error map measures the uncapped estimate with cap = inf)."""
+    rounding, infinite where its largest exceeds `cap` of the linear motion's size
+    (`linear_size`, of `cap_of`; an error map measures the uncapped estimate with cap = inf)."""
     n = red.n
+    linear_size(np.zeros((1, n)), cap_of)  # an unknown cap_of refused before the work
     zL, e, per = linear_motion(red, z0, t, CORRECTIONS, FINE)
     est = FACTOR * group_max(np.max(np.abs(e), axis=0), units)[:n]
     est += ROUNDING * np.finfo(float).eps * per * (len(t) - 1) * np.max(np.abs(zL[:, :n]))
-    excursion = np.max(np.sqrt(np.sum((zL[:, :n] - zL[:1, :n]) ** 2, axis=1)))
-    if not np.max(est) <= cap * excursion:  # beyond the iteration's reach: no bound
+    size = linear_size(zL[:, :n], cap_of)
+    if not np.max(est) <= cap * size:  # beyond the iteration's reach: no bound
         est = np.full(n, np.inf)
     return red.q_ref[red.ri] + zL[:, :n], est
 
 
-def motion_answer(red: ReducedState, z0: np.ndarray, t, units: list, method: str = "linear", rtol: float = 1e-9):
-    """The `motion` question's answer from the reduced state z0: `linear` (linear_answer), or
-    the full equations integrated by a SciPy method at rtol and rtol FINER, the estimate
-    twice their difference, not below twice the finer run's tolerance on the coordinates'
-    size (an error the two runs share where both sit at the absolute tolerance's floor)."""
+def motion_answer(red: ReducedState, z0: np.ndarray, t, units: list, method: str = "linear", rtol: float = 1e-9,
+                  cap_of: str = CAP_OF[0]):
+    """The `motion` question's answer from the reduced state z0: `linear` (linear_answer,
+    capped against the linear motion's size of `cap_of`), or the full equations integrated
+    by a SciPy method at rtol and rtol FINER, the estimate twice their difference, not below
+    twice the finer run's tolerance on the coordinates' size (an error the two runs share
+    where both sit at the absolute tolerance's floor)."""
     t = np.asarray(t, float)
     if method == "linear":
-        return linear_answer(red, z0, t, units)
+        return linear_answer(red, z0, t, units, cap_of=cap_of)
     n = red.n
     zL = linear_motion(red, z0, t, CORRECTIONS, FINE)[0]
     scale = np.array([np.max(np.abs(zL[:, :n])), np.max(np.abs(zL[:, n:]))])

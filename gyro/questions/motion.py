@@ -18,6 +18,9 @@ columns motion_answer returns (default: the coordinates); "scale": "excursion" m
 each quantity's error against the motion's largest excursion from its start (the norm over
 the quantities), not against its largest magnitude (at least 1): the drift of a point
 near the origin is the answer, so its size is the scale.
+
+A linear level on the generic machinery may declare "cap_of" (gyro.analyses.motion.CAP_OF:
+what its estimate's cap is a fraction of); motion_answer then takes it as a keyword.
 """
 from __future__ import annotations
 
@@ -27,6 +30,7 @@ from gyro.questions import Answer, evaluator_module, unknown_kind
 
 NAME = "motion"
 POINTS = 201  # sample times over the horizon
+PASSED = ("cap_of",)  # evaluator options passed on to motion_answer where a level declares them
 DEFAULT_HORIZON = 1.0  # s
 OPTIONS = {"horizon": ("T", "motion: the time span in s (also --t-end)")}
 EPS = 2.220446049250313e-16  # a double's relative rounding: no answer printed as one is closer
@@ -142,12 +146,13 @@ def answer(model, level, P, opts) -> Answer:
     est = np.full((N, nc), np.inf)
     scales = np.full((N, nc), np.nan)
     failed = np.full(N, "", object)
+    extra = {k: level.evaluator[k] for k in PASSED if k in level.evaluator}
     for k in range(N):
         params = dict(zip(model.param_names, map(float, P[k])))
         ic = {n: float(np.broadcast_to(v, (N,))[k]) for n, v in init.items()}
         try:
             q, e = mod.motion_answer(mod.Motion(params, **ic), t, level.evaluator["method"],
-                                     level.evaluator.get("rtol", 1e-10))
+                                     level.evaluator.get("rtol", 1e-10), **extra)
         except (ArithmeticError, ValueError, RuntimeError) as exc:  # a refusal or a failure: its reason
             failed[k] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             continue

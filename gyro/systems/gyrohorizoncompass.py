@@ -33,12 +33,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from gyro.equilibrium import operators
 from gyro.errors import finite_number
 from gyro.kernels import function
 from gyro.models import ParameterError, load
 from gyro import ode, qep
-from gyro.qep import companion_matrix
 
 MODEL = "gyrohorizoncompass"
 NAMES = ("A", "B", "C", "J", "L", "I", "nu", "zeta", "eta", "lambda")
@@ -551,16 +549,11 @@ INITIAL = {
     "depsilon0": ("rad/s", 0.0, "epsilon' at t = 0"),
 }
 LINEAR = "linear"  # motion_answer's method: the linearised equations about (3.1)
-FIRST_STEP_FACTOR = 2.0  # the linear motion's estimate: this times its first correction
-# where the first correction exceeds this fraction of the linear motion's largest excursion
-# (over the angles), one step does not resolve the linearisation's error and the estimate
-# is infinite (measured, bench/levels.py `ghc_motion_edge`: the error stays below twice the
-# first step up to a ratio of 0.3, 0.64 of it there; at 0.4 it is 1.1 times it, at 0.6 3.7
-# times, the Earth set over 10 s); and where it exceeds this fraction of a
-# radian: no tolerance below 1 on a scale of at least 1 rad needs more, and an unstable
-# linear motion that has grown to radians may cross beta = +-90 deg, where the angles (1.1)
-# are singular (the mass matrix of (1.5)-(1.6) is) and the remainder cannot be evaluated
-FIRST_STEP_SMALL = 0.1
+# the linear level's cap is a fraction of the linear motion's displacement from (3.1), at
+# most a radian (gyro.analyses.motion.CAP_OF; the level's declared "cap_of"): on the Earth
+# set over 2 s the slow modes hardly move, so the motion's excursion from its offset start
+# is a tenth of its displacement (docs/hierarchy.md)
+CAP_OF = "displacement"
 
 
 @dataclass(frozen=True)
@@ -585,111 +578,30 @@ class Motion:
                          self.dalpha0, self.dbeta0, self.dgamma0, self.depsilon0], float)
 
 
-def linearisation(values: dict) -> tuple[np.ndarray, np.ndarray]:
-    """(ye, A): the state of the relative equilibrium (3.1), (0, 0, 0, epsilon0) at rest, and
-    the first-order matrix A = [[0, I], [-M^-1 K, -M^-1 D]] of the emitted operator there,
-    the exact linearisation the linear_exact levels take the spectrum of (it is the
-    Jacobian of the emitted equations at ye)."""
-    check_equilibrium(values)
-    ye = initial_state(values)
-    M, D, K = operators(model(), model().vector(values)[None], ye[None, :4])
-    return ye, companion_matrix(M[0], D[0], K[0])
-
-
-def linear_motion(A: np.ndarray, x0: np.ndarray, t) -> np.ndarray:
-    """x(t) = e^{A t} x0 at the times t (times, 2n), the exact solution of x' = A x, step
-    by step: x(t_k+1) = e^{A (t_k+1 - t_k)} x(t_k), SciPy's expm over the batch of the
-    steps (of small norm, so a few Pade terms each: e^{A t_k} itself over a horizon of
-    many periods costs twenty times more)."""
-    from scipy.linalg import expm
-
-    E = expm(A[None] * np.diff(np.asarray(t, float))[:, None, None])
-    out = [np.asarray(x0, float)]
-    for Ek in E:
-        out.append(Ek @ out[-1])
-    return np.array(out)
-
-
-def _rounding(A: np.ndarray, x: np.ndarray, t) -> np.ndarray:
-    """Twice the difference of the stepped linear motion at the horizon's end to the other
-    route there, e^{A (t_N - t_0)} x0 at once (per component): the rounding of the two,
-    which the steps accumulate toward the end."""
-    from scipy.linalg import expm
-
-    t = np.asarray(t, float)
-    return 2 * np.abs(expm(A * (t[-1] - t[0])) @ x[0] - x[-1])
-
-
-def first_correction(values: dict, ye: np.ndarray, A: np.ndarray, x: np.ndarray, t, rtol: float,
-                     budget_s: float | None = None, limit: float = math.inf) -> np.ndarray:
-    """d(t) (times, 8): the response of the linearised equations to the remainder of
-    (1.5)-(1.6) along the linear motion, d' = A d + f(ye + x) - A x, d(0) = 0 (gyro.ode.
-    correction_rhs), integrated beside x' = A x from x(0) = x[0] by DOP853 at rtol; the
-    absolute tolerance of each component is rtol/100 of its linear motion's largest size
-    over the times t (of x: the linear motion at t) and of the largest such size squared
-    (of d: the remainder is of second order in x). The run stops where the largest of
-    the angles' d reaches `limit`; d is infinite from there on (on an unstable set whose
-    linear motion grows, the correction would grow with its square)."""
-    from scipy.integrate import solve_ivp
-
-    t = np.asarray(t, float)
-    xs = np.max(np.abs(x), axis=0)
-    size = max(float(np.max(xs)), np.finfo(float).tiny)
-    atol = rtol * 1e-2 * np.concatenate([np.maximum(xs, size * 1e-6), np.full(8, size**2)])
-    fun = ode.correction_rhs(model(), model().vector(values), ye, A)
-    max_s = math.inf if budget_s is None else budget_s
-    rhs = ode.budgeted(fun, "the linear motion's first correction", t[-1], max_s, BUDGET_STEPS, IntegrationBudget)
-
-    def reached(_, z):
-        return limit - np.max(np.abs(z[8:12]))
-
-    reached.terminal = True
-    sol = solve_ivp(rhs, (t[0], t[-1]), np.concatenate([x[0], np.zeros(8)]), method="DOP853", t_eval=t,
-                    rtol=rtol, atol=atol, events=reached)
-    if not sol.success:
-        raise FloatingPointError(f"the linear motion's first correction: {sol.message}")
-    d = np.full((t.size, 8), np.inf)
-    d[:sol.y.shape[1]] = sol.y.T[:, 8:]
-    return d
-
-
-def motion_answer(motion: Motion, t, method: str = LINEAR, rtol: float = RTOL):
+def motion_answer(motion: Motion, t, method: str = LINEAR, rtol: float = RTOL, cap_of: str = CAP_OF):
     """The `motion` question's evaluator (gyro/questions/motion.py, docs/hierarchy.md): the
     coordinates alpha, beta, gamma, epsilon at the times t (times, 4) from the perturbed
     relative equilibrium, and an estimate of each one's largest absolute error over t (rad).
 
-    `linear`: the motion of the linearised equations, ye + e^{A t} x0, exact (expm). Its
-    estimate against the motion of (1.5)-(1.6), the same for the four angles: twice the
-    largest first correction d over them (`first_correction`, at rtol; d is the linear
-    motion's error to second order in x0, per coordinate), plus the rounding (`_rounding`:
-    two routes of expm compared) and that of ye + x. Measured (bench/levels.py,
-    docs/hierarchy.md): the error is d to within its next order, so twice d bounds it
-    where the first correction is small against the motion; where it exceeds
-    FIRST_STEP_SMALL of the linear motion's largest excursion (or of a radian) the
-    estimate is infinite (the selector goes on to an integrator).
+    `linear`: the generic linear level (gyro.analyses.motion.linear_answer) about the
+    equilibrium (3.1), the perturbation (INITIAL) its z0: the motion of the linearised
+    equations, exact (the exponential of the emitted operator's first-order matrix), and
+    its estimate, twice the correction after two Picard steps toward (1.5)-(1.6) (the
+    largest over the four angles, one unit) plus the rounding; infinite where that exceeds
+    a quarter of the linear motion's size of `cap_of` (the level declares `displacement`:
+    its largest distance from (3.1), at most a radian).
 
     An integrator of METHODS: the equations (1.5)-(1.6) integrated at rtol and rtol/100
     (gyro.ode.two_tolerances; within the command line's budget)."""
+    from gyro.analyses import motion as generic
+
     t = np.asarray(t, float)
     values = motion.params
-    ye, A = linearisation(values)
-    x0 = motion.perturbation
+    check_equilibrium(values)  # the reason in one line where (3.1) does not exist
     if method == LINEAR:
-        x = linear_motion(A, x0, t)
-        rounding = _rounding(A, x, t)[:4]
-        limit = FIRST_STEP_SMALL * min(float(np.max(np.abs(x[:, :4]))), 1.0)
-        d = first_correction(values, ye, A, x, t, rtol, BUDGET_SECONDS, limit)
-        q = ye[:4] + x[:, :4]
-        # the largest first step over the four angles (one unit): the next step carries a
-        # large correction of one angle into the others through the coupling (near zeta = 0,
-        # where alpha's restoring moment I (1 + theta) zeta^2 vanishes, alpha's step is 200 times
-        # the others', whose errors then reach 5 times their own steps)
-        step = float(np.max(np.abs(d[:, :4])))
-        if not step <= limit:
-            return q, np.full(4, np.inf)  # the linearisation fails: its error is not one small step
-        return q, FIRST_STEP_FACTOR * step + rounding + U * np.max(np.abs(q), axis=0)
-
-    y0 = ye + x0
+        red = generic.ReducedState(model(), values)
+        return generic.linear_answer(red, motion.perturbation, t, ["rad"] * 4, cap_of=cap_of)
+    y0 = initial_state(values) + motion.perturbation
     return ode.two_tolerances(lambda r: integrate(values, y0, t, method, r, r * 1e-2, budget_s=BUDGET_SECONDS,
                                                   budget_steps=BUDGET_STEPS)[:, :4], rtol)
 

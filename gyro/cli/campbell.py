@@ -6,7 +6,7 @@ import json
 import math
 import sys
 
-from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_scheduler, add_set,
+from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_scheduler, add_set, has_spin,
                              check_png_out, model_with_equilibrium, parse_sets)
 from gyro.errors import ParameterError
 
@@ -18,7 +18,7 @@ MAX_HARMONIC = 1000
 def register(sub) -> None:
     c = sub.add_parser("campbell", help="Campbell diagram: frequencies against spin, whirl, damping, "
                                         "harmonic lines and critical speeds")
-    add_model(c)
+    add_model(c, help="the model: an operator and a spin (Model.spin, or a parameter in rad/s)", declares=has_spin)
     add_set(c)
     add_out(c, required=False, help="the figure (--out or --json or both)")
     add_json(c)

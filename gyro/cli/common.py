@@ -31,6 +31,17 @@ class Parser(argparse.ArgumentParser):
         sys.exit(EXIT_USAGE)
 
 
+def has_operator(meta: dict) -> bool:
+    """A model whose operator is about a relative equilibrium of its parameters (not of
+    momenta given as inputs): what frequencies, sweeps, maps and tolerances need."""
+    return "operator" in meta.get("functions", {}) and not meta.get("momenta")
+
+
+def has_spin(meta: dict) -> bool:
+    """An operator and a spin: a declared one (Model.spin) or a parameter in rad/s."""
+    return has_operator(meta) and bool(meta.get("spin") or any(p["unit"] == "rad/s" for p in meta["parameters"]))
+
+
 def add_model(p, models=None, help="the model (gyro params MODEL lists its parameters)", declares=None) -> None:
     """The positional MODEL, its choices the generated models (or `models`). With `declares`
     (a predicate on a model's metadata) the help lists the generated models that declare what

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import json
 
-from gyro.cli.common import add_json, add_model, add_set, model_with_equilibrium, parse_sets
+from gyro.cli.common import add_json, add_model, add_set, model_with_equilibrium, parse_sets, has_operator
 from gyro.errors import ParameterError
 from gyro.methods import names as method_names
 
@@ -12,7 +12,7 @@ ORDER = 10
 
 def register(sub) -> None:
     f = sub.add_parser("frequencies", help="natural frequencies of a model's exact linear operator")
-    add_model(f)
+    add_model(f, help="the model: an operator about a relative equilibrium", declares=has_operator)
     add_set(f)
     add_json(f)
     f.add_argument("--method", default="default", choices=method_names(),

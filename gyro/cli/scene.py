@@ -18,7 +18,7 @@ def register(sub) -> None:
     from gyro.questions import names
 
     f = sub.add_parser("scene", help="answer a question at a tolerance with the cheapest adequate level")
-    add_model(f)
+    add_model(f, help="the model: a hierarchy of levels (Model.levels)", declares=lambda meta: bool(meta.get("levels")))
     f.add_argument("question", metavar="QUESTION", choices=names(),
                    help=f"what to answer; one of: {', '.join(names())}")
     f.add_argument("--tol", required=True, metavar="REL", help="relative tolerance, a number in (0, 1)")

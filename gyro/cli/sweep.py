@@ -8,7 +8,7 @@ import json
 import math
 import sys
 
-from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_scheduler, add_set, axis,
+from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_scheduler, add_set, axis, has_operator,
                              axis_points, check_png_out, model_with_equilibrium, parse_sets)
 from gyro.errors import ParameterError
 from gyro.methods import names as method_names
@@ -18,7 +18,7 @@ ORDER = 35
 
 def register(sub) -> None:
     s = sub.add_parser("sweep", help="natural frequencies against one parameter")
-    add_model(s)
+    add_model(s, help="the model: an operator about a relative equilibrium", declares=has_operator)
     add_set(s)
     s.add_argument("--x", required=True, metavar="NAME=LO:HI[:N]", help="the parameter swept and its range "
                    "(or NAME with --x-range)")

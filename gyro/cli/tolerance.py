@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 import sys
 
-from gyro.cli.common import (add_json, add_model, add_out, add_quiet, add_scheduler, add_set, check_png_out,
+from gyro.cli.common import (add_json, add_model, add_out, add_quiet, add_scheduler, add_set, check_png_out, has_operator,
                              method_cost, model_with_equilibrium, parse_sets, refuse_over_budget,
                              writable_folder)
 from gyro.errors import ParameterError
@@ -18,7 +18,7 @@ MAX_SAMPLES = 10**9
 
 def register(sub) -> None:
     t = sub.add_parser("tolerance", help="frequency distributions over parameter spreads: first order and sampled")
-    add_model(t)
+    add_model(t, help="the model: an operator about a relative equilibrium", declares=has_operator)
     add_set(t)
     t.add_argument("--spread", action="append", default=[], required=True, metavar="NAME=normal:SIGMA|uniform:HALFWIDTH",
                    help="a parameter's spread, relative to its value (Kp=normal:0.05 is 5 %%); repeat as needed")

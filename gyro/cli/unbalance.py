@@ -8,7 +8,7 @@ import json
 import math
 import sys
 
-from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_set, check_png_out,
+from gyro.cli.common import (add_json, add_model, add_out, add_points, add_quiet, add_set, check_png_out, has_spin,
                              parse_sets)
 
 ORDER = 62
@@ -16,7 +16,7 @@ ORDER = 62
 
 def register(sub) -> None:
     s = sub.add_parser("unbalance", help="unbalance response over a spin range (any model with inputs)")
-    add_model(s)
+    add_model(s, help="the model: an operator, a spin and force inputs", declares=lambda meta: has_spin(meta) and "input_matrix" in meta["functions"])
     s.add_argument("--force-x", required=True, metavar="NAME", help="input that takes ME W^2 cos(W t + PHI)")
     s.add_argument("--force-y", required=True, metavar="NAME", help="input that takes ME W^2 sin(W t + PHI)")
     s.add_argument("--magnitude", required=True, type=float, metavar="ME", help="unbalance m e [kg m]")

@@ -157,3 +157,21 @@ def test_scene_takes_each_questions_own_options_and_refuses_the_others():
                                                            "takes --horizon)")):
         rc, out, err = run_cli("scene", "torsion_gyrocompass", args[0], "--tol", "1e-3", *args[1:])
         assert rc == 2 and out == "" and error_lines(err) == [f"gyro: error: {says}"], err
+
+
+@pytest.mark.parametrize("command, listed, not_listed", [
+    ("frequencies", ["torsion_gyrocompass", "gyrohorizoncompass"], ["gimbal_gyroscope"]),
+    ("sweep", ["torsion_gyrocompass"], ["gimbal_gyroscope"]),
+    ("campbell", ["torsion_gyrocompass"], ["gimbal_gyroscope"]),
+    ("unbalance", ["torsion_gyrocompass"], ["gimbal_gyroscope", "gyrohorizoncompass"]),
+    ("scene", ["gimbal_gyroscope", "torsion_gyrocompass"], []),
+])
+def test_a_commands_help_lists_the_models_that_can_answer_it(command, listed, not_listed):
+    """The MODEL list of a command's help holds the generated models that declare what it
+    needs (an operator about a relative equilibrium, not one of momenta given as inputs; a
+    spin; inputs; levels), and says what that is."""
+    rc, out, _ = run_cli(command, "--help")
+    assert rc == 0
+    text = " ".join(out.split())
+    models = text.split("one of: ", 1)[1].split(", or a model file", 1)[0].split(", ")
+    assert set(listed) <= set(models) and not set(not_listed) & set(models), models

@@ -11,6 +11,8 @@ import mpmath
 import numpy as np
 import pytest
 
+from gyro import qep
+from gyro.equilibrium import operators
 from gyro.systems import gyrohorizoncompass as ghc
 from gyro.methods import reference
 from gyro.results import Spectrum, classify, verdict
@@ -151,9 +153,9 @@ def test_every_exact_eigenvalue_lies_in_a_disk(case):
         exact, A_exact = _exact_eigenvalues(v)
         for z in exact:
             assert np.any(np.abs(w - z) <= r), (z, w, r)
-        M, D, K = ghc.operators(ghc.model(), ghc.model().vector(_floats(v))[None],
-                                np.array([[0, 0, 0, a["epsilon0"][0]]]))
-        A = ghc.companion_matrix(M, D, K)[0]
+        M, D, K = operators(ghc.model(), ghc.model().vector(_floats(v))[None],
+                            np.array([[0, 0, 0, a["epsilon0"][0]]]))
+        A = qep.companion_matrix(M, D, K)[0]
         assert np.linalg.norm(A - A_exact) <= 8 * U * np.linalg.norm(A_exact)
         if case == "on the row chi = 0.32":  # a certain growth elsewhere, or a boundary
             assert a["verdict"].label[0] in ("boundary", "unstable")

@@ -10,6 +10,7 @@ gyrocompass's given forces and their rates). Called from NumPy it costs about a 
 the emitted NumPy functions' per-call overhead on the 11-coordinate model."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -206,3 +207,58 @@ def two_tolerances(run, rtol: float, finer: float = 1e-2):
     q1 = run(rtol)
     q2 = run(rtol * finer)
     return q2, 2 * np.max(np.abs(q1 - q2), axis=0)
+
+
+SCIPY_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
+STIFF = ("Radau", "BDF", "LSODA")  # SciPy's methods that take the Jacobian
+# SUNDIALS through CasADi: the integrator and its options (cvodes-adams: non-stiff
+# Adams-Moulton with fixed-point iteration; cvodes: BDF, CasADi's default; idas: the DAE form)
+SUNDIALS = {"cvodes": ("cvodes", {}), "idas": ("idas", {}),
+            "cvodes-adams": ("cvodes", {"linear_multistep_method": "adams", "nonlinear_solver_iteration": "functional"})}
+
+
+def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budget_s: float = math.inf,
+                    budget_steps: float = math.inf, jac: bool = False) -> np.ndarray:
+    """States (len(t), 2n) of y' = f(y, P) (the emitted equations of motion, the inputs zero)
+    from y0 at t[0], at the times t: one integrator for every model's motions.
+
+    SciPy's METHODS (solve_ivp; with `jac` the stiff ones take the exact Jacobian), within
+    `budget_s` seconds and `budget_steps` evaluations (IntegrationBudget beyond, saying how far
+    it got; FloatingPointError where the method fails). SUNDIALS' (cvodes, cvodes-adams,
+    idas), budget_steps shared out over the output intervals (at least 500 each; SUNDIALS
+    counts steps between outputs), its own lines on stderr silenced: IntegrationBudget where
+    it gives up (its budget, or a failed step). The budgets are the command line's; a library
+    call without them runs to the end."""
+    import casadi as ca
+
+    t = np.asarray(t, float)
+    y0 = np.asarray(y0, float)
+    P = np.asarray(P, float)
+    if method in SCIPY_METHODS:
+        from scipy.integrate import solve_ivp
+
+        kw = {}
+        if jac and method in STIFF:
+            J = jacobian(model)
+            zeros = [np.zeros(v.numel()) for v in symbolic(model).inputs]
+            kw["jac"] = lambda _, Y: np.asarray(J(Y, ca.DM(P), *zeros)[1])
+        fun = budgeted(numpy_rhs(model, P), method, t[-1], budget_s, budget_steps, IntegrationBudget)
+        sol = solve_ivp(fun, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol, **kw)
+        if not sol.success:
+            raise FloatingPointError(f"{method}: {sol.message}")
+        return sol.y.T
+    if method in SUNDIALS:
+        name, extra = SUNDIALS[method]
+        s = symbolic(model)
+        xdot = ca.substitute([s.ydot], [s.p, *s.inputs], [ca.DM(P), *[ca.DM.zeros(v.numel()) for v in s.inputs]])[0]
+        per = 10**9 if math.isinf(budget_steps) else max(500, int(budget_steps) // max(1, len(t) - 1))
+        opts = {"abstol": atol, "reltol": rtol, "max_num_steps": int(min(per, 10**9)), **CASADI_QUIET, **extra}
+        F = ca.integrator("F", name, {"x": s.y, "ode": xdot}, t[0], t[1:], opts)
+        try:
+            with stderr_silenced():  # SUNDIALS' error lines (IDAS prints them whatever the options)
+                Y = np.array(F(x0=y0)["xf"]).T
+        except RuntimeError:  # SUNDIALS gives up (its step budget, or a failed step)
+            raise IntegrationBudget(f"{method} stopped before t = {t[-1]:.6g} s (its budget of {per:.3g} steps "
+                                    "between output times, or a failed step)") from None
+        return np.vstack([y0, Y])
+    raise ValueError(f"unknown method {method!r}; known: {' '.join(SCIPY_METHODS + tuple(SUNDIALS))}")

@@ -358,7 +358,6 @@ def integrate_reduced(red: ReducedState, z0: np.ndarray, t, method: str = "DOP85
     |x'|), so a small perturbation is resolved, but not below `floor` eps of the reference's
     largest coordinate (and that times the fastest frequency for the rates): there the
     state's rounding, amplified by stiff springs, would stall the steps."""
-    from scipy.integrate import solve_ivp
 
     t = np.asarray(t, float)
     n = red.n
@@ -371,11 +370,8 @@ def integrate_reduced(red: ReducedState, z0: np.ndarray, t, method: str = "DOP85
     atol = np.empty(2 * red.nq)
     atol[:red.nq] = max(1e-3 * rtol * scale[0], lo, np.finfo(float).tiny)
     atol[red.nq:] = max(1e-3 * rtol * scale[1], lo * w_max, np.finfo(float).tiny)
-    sol = solve_ivp(ode.numpy_rhs(red.model, red.P), (t[0], t[-1]), red.state(z0[:n], z0[n:]), method=method,
-                    t_eval=t, rtol=rtol, atol=atol)
-    if not sol.success:
-        raise RuntimeError(f"{method}: {sol.message}")
-    return sol.y[red.ri].T
+    Y = ode.integrate_state(red.model, red.P, red.state(z0[:n], z0[n:]), t, method, rtol, atol)
+    return Y[:, red.ri]
 
 
 def group_max(v: np.ndarray, units: list) -> np.ndarray:

@@ -493,7 +493,7 @@ def mean_drift_paper(motion: Motion, theta_a: float, theta_b: float) -> float:
 
 # ------------------------------------------------------------------ integrating (1.1)
 
-SCIPY_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
+SCIPY_METHODS = ode.SCIPY_METHODS
 CASADI_METHODS = ("cvodes", "idas")
 METHODS = ("closed_form", *SCIPY_METHODS, *CASADI_METHODS)
 
@@ -517,29 +517,9 @@ def integrate(motion: Motion, t, method: str = "DOP853", rtol: float = 1e-12, at
     P = param_vector(motion.params)
     y0 = np.concatenate([motion.q0, motion.qd0])
     budget_s = math.inf if budget_s is None else budget_s
-    if method in SCIPY_METHODS:
-        from scipy.integrate import solve_ivp
-
-        rhs = ode.budgeted(ode.numpy_rhs(load(MODEL), P), method, t[-1], budget_s, budget_steps, IntegrationBudget)
-        sol = solve_ivp(rhs, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol)
-        if not sol.success:
-            raise FloatingPointError(f"{method}: {sol.message}")
-        Y = sol.y.T
-    elif method in CASADI_METHODS:
-        import casadi as ca
-
-        sym = ode.symbolic(load(MODEL))
-        y, ydot = sym.y, ca.substitute(sym.ydot, sym.p, ca.DM(P))
-        opts = {"abstol": atol, "reltol": rtol, "max_num_steps": budget_steps, **ode.CASADI_QUIET}
-        F = ca.integrator("F", method, {"x": y, "ode": ydot}, t[0], t, opts)
-        try:
-            with ode.stderr_silenced():  # SUNDIALS' error lines (IDAS prints them whatever the options)
-                Y = np.array(F(x0=y0)["xf"]).T
-        except RuntimeError as exc:  # SUNDIALS gives up (its step budget, or a failed step)
-            why = "its step budget" if "MXSTEP" in str(exc) or "mxstep" in str(exc).lower() else "a failed step"
-            raise IntegrationBudget(f"{method} stopped before t = {t[-1]:.6g} s ({why})") from None
-    else:
+    if method not in SCIPY_METHODS + CASADI_METHODS:
         raise ParameterError(f"unknown method {method!r}; known: {' '.join(METHODS)}")
+    Y = ode.integrate_state(load(MODEL), P, y0, t, method, rtol, atol, budget_s, budget_steps)
     return Y[:, :3], Y[:, 3:]
 
 

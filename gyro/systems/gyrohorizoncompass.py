@@ -376,7 +376,7 @@ def condition_map(base: dict, xaxis, yaxis, orbit: bool = False, lambda_follows:
 
 # ------------------------------------------------------------------ motions
 
-SCIPY_METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")
+SCIPY_METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")  # gyro.ode's, DOP853 first: the default
 CASADI_METHODS = ("cvodes", "cvodes-adams")  # cvodes: BDF (CasADi's default); cvodes-adams: Adams-Moulton
 PROJECTED = "projected"  # fixed-step DOP853 tableau, each step projected onto E = E(0)
 METHODS = (*SCIPY_METHODS, *CASADI_METHODS, PROJECTED)
@@ -437,38 +437,9 @@ def integrate(values: dict, y0: np.ndarray, t: np.ndarray, method: str = "DOP853
     start = time.perf_counter()
     max_s = math.inf if budget_s is None else budget_s
     max_steps = math.inf if budget_steps is None else budget_steps
-    if method in SCIPY_METHODS:
-        from scipy.integrate import solve_ivp
-
-        ca, y, p, ydot, _ = _casadi_rhs()
-        f = ca.Function("f", [y, p], [ydot])
-        jf = ca.Function("J", [y, p], [ca.jacobian(ydot, y)])
-        kw = {"jac": lambda _, Y: np.array(jf(Y, P))} if method in ("Radau", "BDF", "LSODA") else {}
-        rhs = ode.budgeted(lambda _, Y: np.array(f(Y, P)).ravel(), method, t[-1], max_s - (time.perf_counter() - start),
-                           max_steps, IntegrationBudget)
-        sol = solve_ivp(rhs, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol, **kw)
-        if not sol.success:
-            raise FloatingPointError(f"{method}: {sol.message}")
-        return sol.y.T
-    if method in CASADI_METHODS:
-        from gyro.ode import CASADI_QUIET, stderr_silenced
-
-        ca, y, p, ydot, _ = _casadi_rhs()
-        xdot = ca.substitute(ydot, p, ca.DM(P))
-        # SUNDIALS counts steps between output times; no budget (a library call): SUNDIALS' own
-        # ceiling (inf // k is NaN, and max(500, NaN) was 500 steps an interval)
-        per = 10**9 if math.isinf(max_steps) else max(500, max_steps // max(1, len(t) - 1))
-        opts = {"abstol": atol, "reltol": rtol, "max_num_steps": int(min(per, 10**9)), **CASADI_QUIET}
-        if method == "cvodes-adams":  # non-stiff: Adams-Moulton with fixed-point iteration
-            opts.update(linear_multistep_method="adams", nonlinear_solver_iteration="functional")
-        F = ca.integrator("F", "cvodes", {"x": y, "ode": xdot}, t[0], t[1:], opts)
-        try:
-            with stderr_silenced():  # SUNDIALS' error lines: the error below says it
-                Y = np.array(F(x0=y0)["xf"]).T
-        except RuntimeError:  # SUNDIALS gives up (its step budget, or a failed step)
-            raise IntegrationBudget(f"{method} stopped before t = {t[-1]:.6g} s (its budget of "
-                                    f"{opts['max_num_steps']:.3g} steps between output times, or a failed step)") from None
-        return np.vstack([y0, Y])
+    if method in SCIPY_METHODS or method in CASADI_METHODS:
+        return ode.integrate_state(model(), P, y0, t, method, rtol, atol, max_s - (time.perf_counter() - start),
+                                   max_steps, jac=True)
     if method == PROJECTED:
         if len(t) < 2:
             return y0[None]

@@ -123,8 +123,9 @@ def eliminate(model: Model, deps: list, sol: dict) -> tuple[Model, dict]:
     return out, info
 
 
-def multipliers(model: Model, Q, steps):
-    """The derivation with Lagrange multipliers (module docstring)."""
+def multipliers(model: Model, Q, steps, d: Derivation) -> Derivation:
+    """The derivation d with Lagrange multipliers (module docstring): its equations, operator
+    and B filled (derive/passes/constraints.py chooses this route)."""
 
     phis = _constraints(model)
     m, n = len(phis), len(model.q)
@@ -178,10 +179,10 @@ def multipliers(model: Model, Q, steps):
         residual = (C.T * f0)
         op = mech.LinearOperator(Mr, Dr, Kr)
     rq = [q[i] for i in ind]
-    d = Derivation(model=model, mass_matrix=Maug, forcing=faug, routhian=model.lagrangian, rq=rq,
-                   rqd=[qd[i] for i in ind], rqdd=[qdd[i] for i in ind], even=q,
-                   equilibrium_residual=residual, operator=op, route_agreement=None, order=order,
-                   time_dependent=TIME in (Maug.free_symbols | faug.free_symbols))
+    d.mass_matrix, d.forcing, d.routhian = Maug, faug, model.lagrangian
+    d.rq, d.rqd, d.rqdd, d.even = rq, [qd[i] for i in ind], [qdd[i] for i in ind], q
+    d.equilibrium_residual, d.operator, d.route_agreement, d.order = residual, op, None, order
+    d.time_dependent = TIME in (Maug.free_symbols | faug.free_symbols)
     w = list(model.input_signal_symbols)
     if w:
         Bq = -E.jacobian(w).subs(rest)

@@ -7,7 +7,7 @@ coordinates, their rates and accelerations, with no assumptions.
   name). `qd` and `qdd` may be left empty, or given as speeds `dynamicsymbols('u')`. With
   kinematic equations (`kinematics`, KanesMethod's kd_eqs) a speed is what they say: every
   u is replaced by its expression in q and q', and the record of q' = V u + v goes to the
-  derivation, which forms the equations in the speeds (pipeline.speeds_equations). Without
+  derivation, which forms the equations in the speeds (derive/passes/speeds.py). Without
   them a speed stands for its coordinate's derivative, and must be it in every velocity of
   the model's frames and load points it enters; a speed that is not, or that enters none
   the machinery can see, is refused (_check_rates), never guessed.

@@ -1,10 +1,15 @@
 """The result of a derivation (derive/pipeline.py): what the output kinds of
 derive/outputs/ turn into functions and metadata. A leaf: it imports the model's data and
-the machinery's types, no step of the derivation, so that every step (the pipeline, the
-multipliers of derive/constraints.py) returns it without importing another step."""
+the machinery's types, no step of the derivation, so that every pass of derive/passes/
+(and the multipliers of derive/constraints.py) fills it without importing another step.
+
+A derivation starts as `Derivation(model)`; each pass fills its part. What one pass hands
+to a later one and no output kind reads (the Lagrangian without inputs, the kinks, the
+second route's operator) is in `work`, emptied by the last pass."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import sympy as sp
 
@@ -24,16 +29,16 @@ class VariantResult:
 @dataclass
 class Derivation:
     model: Model
-    mass_matrix: sp.Matrix  # full nonlinear equations: mass_matrix * qdd = forcing
-    forcing: sp.Matrix
-    routhian: object
-    rq: list  # reduced coordinates, velocities, accelerations (operator order)
-    rqd: list
-    rqdd: list
-    even: list  # reduced coordinates that are unknowns of the reference (not zero by symmetry)
-    equilibrium_residual: sp.Matrix  # minus the equations at the reference, function of `even`
-    operator: mech.LinearOperator  # exact, at the reference, function of `even`
-    route_agreement: float | None  # max |route1 - route2| / max |route2| at random points (None: one route)
+    mass_matrix: sp.Matrix | None = None  # full nonlinear equations: mass_matrix * qdd = forcing
+    forcing: sp.Matrix | None = None
+    routhian: object = None
+    rq: list = field(default_factory=list)  # reduced coordinates, velocities, accelerations (operator order)
+    rqd: list = field(default_factory=list)
+    rqdd: list = field(default_factory=list)
+    even: list = field(default_factory=list)  # reduced coordinates that are unknowns of the reference
+    equilibrium_residual: sp.Matrix | None = None  # minus the equations at the reference, function of `even`
+    operator: mech.LinearOperator | None = None  # exact, at the reference, function of `even`
+    route_agreement: float | None = None  # max |route1 - route2| / max |route2| at random points (None: one route)
     order: list = field(default_factory=list)  # names of the reduced coordinates
     rates: dict = field(default_factory=dict)  # velocity symbol -> rate on a steady motion
     inputs: list = field(default_factory=list)  # w: columns of B (symbols)
@@ -55,6 +60,12 @@ class Derivation:
     # non-smooth terms whose derivative the operator or B needs: term -> its argument at
     # the reference ("0": the reference sits on the kink, the operator exists at no set)
     nondifferentiable: dict = field(default_factory=dict)
+    # how the equations are formed: "coordinates" (independent ones, after any elimination
+    # of holonomic constraints) or "multipliers" (derive/constraints.py); each pass of
+    # derive/passes/ names the routes it runs on (ROUTES)
+    route: str = "coordinates"
+    # what passes hand to later passes (`steps`, the printer of timed steps, among them)
+    work: SimpleNamespace = field(default_factory=SimpleNamespace)
 
     @property
     def momenta(self) -> list:

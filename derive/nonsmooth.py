@@ -32,6 +32,8 @@ import sympy as sp
 
 from derive.model import Unsupported
 
+NONSMOOTH = (sp.sign, sp.Heaviside, sp.Abs, sp.Max, sp.Min)  # what is frozen into kinks
+
 
 @dataclass(frozen=True)
 class Kink:

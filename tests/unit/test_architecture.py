@@ -80,6 +80,12 @@ def test_no_import_cycles_in_the_derivation():
     graph = import_graph(ROOT / "derive")
     assert _cycle(graph) is None, " -> ".join(_cycle(graph))
     assert graph["derive.derivation"] <= {"derive.mechanics", "derive.names", "derive.model"}
+    # the passes sit below the pipeline that runs them and the outputs that read their result
+    passes = [m for m in graph if m.startswith("derive.passes.")]
+    assert len(passes) > 1
+    for m in passes:
+        assert not [d for d in graph[m] if d in ("derive.pipeline", "derive.emit", "derive.__main__")
+                    or d.startswith("derive.outputs")], m
 
 
 def test_the_cycle_finder_finds_one():

@@ -1,0 +1,84 @@
+"""The linear operator M p^2 + D p + K about the reference by two routes that must agree:
+route 2, the second variation of the Routhian with the forces linearised (the operator
+emitted); route 1, the full equations linearised with the cyclic rates eliminated through
+their integrals. Their 30-digit comparison runs here, or beside the next passes where the
+derivation has more than one core (derive.parallel.JOBS; the agreement pass)."""
+from __future__ import annotations
+
+import random
+
+import sympy as sp
+
+from derive import mechanics as mech
+from derive import nonsmooth, parallel
+from derive.model import Model
+
+ORDER = 90
+ROUTES = ("coordinates",)
+
+
+def _random_point(symbols, rng):
+    """Exact rational values in [1/2, 2] for every symbol: no rounding in the check."""
+    return {s: sp.Rational(rng.randint(500, 2000), 1000) for s in symbols}
+
+
+def compare_operators(op1: mech.LinearOperator, op2: mech.LinearOperator, points=3, seed=0) -> float:
+    """Largest difference of the two operators relative to the largest entry, evaluated
+    with 30 digits at random exact rational points of all their symbols."""
+    rng = random.Random(seed)
+    mats = [op1.M, op1.D, op1.K, op2.M, op2.D, op2.K]
+    syms = sorted(set().union(*[m_.free_symbols for m_ in mats]), key=str)
+    worst = 0.0
+    for _ in range(points):
+        pt = _random_point(syms, rng)
+        for A1, A2 in ((op1.M, op2.M), (op1.D, op2.D), (op1.K, op2.K)):
+            v1 = [sp.N(e.xreplace(pt), 30) for e in A1]
+            v2 = [sp.N(e.xreplace(pt), 30) for e in A2]
+            scale = max(abs(x) for x in v2) or 1
+            worst = max(worst, float(max(abs(x - y) for x, y in zip(v1, v2)) / scale))
+    return worst
+
+
+def agree(agreement: float) -> float:
+    if agreement > 1e-25:
+        raise AssertionError(f"routes 1 and 2 disagree: {agreement:.3e}")
+    return agreement
+
+
+def reduced_order(model: Model, d, E) -> list:
+    """Equations E of all coordinates with the cyclic rates eliminated through their
+    integrals, in the order of the reduced coordinates."""
+    if model.cyclic:
+        E = mech.eliminate_cyclic(E, model.q, model.qd, model.qdd, [model.coordinates.index(c) for c in model.cyclic],
+                                  d.work.L0, list(model.cyclic.values()), model.signals)
+    names_after = [c for c in model.coordinates if c not in model.cyclic]
+    return [E[names_after.index(c)] for c in d.order]
+
+
+def run(model: Model, d):
+    w, signals = d.work, model.signals
+    at = {"at": w.zero_set, "rates": d.rates}
+    with w.steps("linear operator, route 2: second variation of the Routhian, forces linearised"):
+        op2 = mech.quadratic_expansion(d.routhian, d.rq, d.rqd, signals=signals, **at)
+        if w.Q0r is not None:
+            Qq, Qv = mech.linearize_forces(w.Q0r, d.rq, d.rqd, **at)
+            op2 = mech.LinearOperator(op2.M, op2.D - Qv, op2.K - Qq)
+    d.operator = op2
+
+    with w.steps("linear operator, route 1: linearising the full equations with the integral"):
+        E = reduced_order(model, d, mech.lagrange_equations(w.L0, model.q, model.qd, model.qdd, w.Q0, signals))
+        op1 = mech.linearize_equations(E, d.rq, d.rqd, d.rqdd, **at)
+
+    kinks = w.kinks
+    w.undefined = None
+    if kinks.kinks:  # where the non-smooth terms leave an entry without a derivative
+        w.undefined = [nonsmooth.undefined_where(kinks, E, xs, w.reference, model.name)
+                       for xs in (d.rqdd, d.rqd, d.rq)]
+
+    # a check that nothing below needs until the metadata: beside the next passes where the
+    # derivation has more than one core (derive.parallel.JOBS), else here
+    with w.steps("the two routes agree (30 digits, random rational points)"
+                 + (", beside the next steps" if parallel.beside() else "")):
+        w.check = parallel.later(lambda: compare_operators(op1, op2))
+        d.route_agreement = None if w.check.beside else agree(w.check.result())
+    return d

@@ -1,0 +1,77 @@
+"""The derivation as passes (derive/passes/): discovered from the folder in their ORDER,
+each a function run(model, derivation) -> derivation on the routes it names; the
+constraints pass chooses elimination or multipliers within the one derivation."""
+from __future__ import annotations
+
+import inspect
+import io
+
+import pytest
+import sympy as sp
+
+from derive import passes, pipeline
+from derive.derivation import Derivation
+from derive.model import Model, Parameter
+from tests.conftest import ROOT
+
+ROUTES = {"coordinates", "multipliers"}
+
+
+def test_every_module_of_the_folder_is_a_pass_in_its_order():
+    found = passes.passes()
+    files = sorted(p.stem for p in (ROOT / "derive" / "passes").glob("*.py") if not p.stem.startswith("_"))
+    assert sorted(m.__name__.rsplit(".", 1)[-1] for m in found) == files
+    orders = [m.ORDER for m in found]
+    assert orders == sorted(orders) and len(set(orders)) == len(orders), orders
+    for m in found:
+        assert list(inspect.signature(m.run).parameters) == ["model", "d"], m.__name__
+        assert m.ROUTES and set(m.ROUTES) <= ROUTES, m.__name__
+    # the natural seams, in the order the derivation takes them
+    names = [m.__name__.rsplit(".", 1)[-1] for m in found]
+    assert names.index("conversion") < names.index("constraints") < names.index("checks") \
+        < names.index("equations") < names.index("routh") < names.index("reference") \
+        < names.index("operator") < names.index("inputs") < names.index("variants") < names.index("finish")
+
+
+def _pendulum(holonomic_y: bool) -> Model:
+    """A pendulum of length l in Cartesian x, y: on x^2 + y^2 = l^2 (no linear solve, so
+    multipliers) or with the constraint y = -l, linear (eliminated)."""
+    x, y, xd, yd, xdd, ydd = sp.symbols("x y x_d y_d x_dd y_dd")
+    m, g, l = sp.symbols("m g l")
+    params = [Parameter("m", "kg", 1.0, "mass"), Parameter("g", "m/s^2", 9.81, "gravity"),
+              Parameter("l", "m", 1.0, "length")]
+    phi = y + l if holonomic_y else x**2 + y**2 - l**2
+    return Model(name="probe", title="probe", source="test", module=__name__, parameters=params,
+                 coordinates=["x", "y"], coordinate_units={"x": "m", "y": "m"}, q=[x, y], qd=[xd, yd],
+                 qdd=[xdd, ydd], lagrangian=m * (xd**2 + yd**2) / 2 - m * g * y, holonomic=[phi],
+                 reduced=["x"])
+
+
+def _ran(monkeypatch, model) -> tuple[list, Derivation]:
+    """The passes that ran on `model`, in the order they ran, each checked to be handed the
+    model as the passes before left it and to return the one derivation."""
+    ran = []
+    for m in passes.passes():
+        def spy(model, d, _run=m.run, _name=m.__name__.rsplit(".", 1)[-1]):
+            assert model is d.model
+            ran.append(_name)
+            out = _run(model, d)
+            assert out is d
+            return out
+        monkeypatch.setattr(m, "run", spy)
+    return ran, pipeline.derive(model, pipeline.Steps(out=io.StringIO()))
+
+
+@pytest.mark.parametrize("linear", [True, False])
+def test_the_constraints_pass_chooses_elimination_or_multipliers(monkeypatch, linear):
+    ran, d = _ran(monkeypatch, _pendulum(holonomic_y=linear))
+    if linear:  # eliminated: every pass of the coordinates route, in order
+        assert ran == [m.__name__.rsplit(".", 1)[-1] for m in passes.passes() if "coordinates" in m.ROUTES]
+        assert d.route == "coordinates" and d.model.coordinates == ["x"] and "eliminated" in d.constraints
+    else:  # multipliers: the constraints pass formed the equations, the operator; then only
+        # the passes of the multipliers route
+        after = [m.__name__.rsplit(".", 1)[-1] for m in passes.passes() if "multipliers" in m.ROUTES]
+        assert ran == ["conversion", "constraints"] + [n for n in after if n not in ("conversion", "constraints")]
+        assert d.route == "multipliers" and d.constraints["multipliers"] == ["lam1"]
+        assert d.mass_matrix.shape == (3, 3) and d.operator.M.shape == (1, 1)
+    assert d.timings and not vars(d.work)  # what passes handed on is gone

@@ -157,7 +157,8 @@ def _derive_one(module, model, out: Path) -> str | None:
     except Exception as exc:  # what no check foresaw: still one line, naming the step
         step = steps.current or "derivation"
         return f"{name}: {step} failed: {type(exc).__name__}: {_first_line(exc)}"
-    print(f"[{name}] {len(files)} files in {out / model.name}; {steps.total:.1f} s", file=sys.stderr, flush=True)
+    sys.stderr.write(f"[{name}] {len(files)} files in {out / model.name}; {steps.total:.1f} s\n")  # one write
+    sys.stderr.flush()
     return None
 
 

@@ -32,13 +32,19 @@ class Steps:
     @contextmanager
     def __call__(self, name: str):
         t0 = time.perf_counter()
-        print(f"{self.prefix}{name} ...", file=self.out, flush=True)
+        self._say(f"{self.prefix}{name} ...")
         self.current = name
         yield
         self.current = None
         dt = time.perf_counter() - t0
         self.timings.append((name, dt))
-        print(f"{self.prefix}{name}: {dt:.2f} s", file=self.out, flush=True)
+        self._say(f"{self.prefix}{name}: {dt:.2f} s")
+
+    def _say(self, line: str) -> None:
+        """One line in one write (print's text and newline are two, and a worker stopped
+        between them left a line without its end, which the parent's error then joined)."""
+        self.out.write(line + "\n")
+        self.out.flush()
 
     @property
     def total(self) -> float:

@@ -155,9 +155,10 @@ DEPENDENT_STARTS = (1.0, 0.5, -1.0, 2.0, -0.5, 0.1)
 def on_constraints(model: Model, P, q0, is_angle, max_iter: int = 50):
     """The starts of a model with multipliers moved onto its constraints: the independent
     coordinates as they are, the dependent ones solved from phi(q) = 0 by Newton's method on
-    the emitted constraints and their Jacobian (quantity `constraints`), from each of
-    DEPENDENT_STARTS in turn (a start of zero puts a pendulum in Cartesian coordinates at its
-    pivot, where the constraint's Jacobian vanishes). The first start whose iteration meets
+    the emitted constraints and their Jacobian (quantity `constraints`), from the start as
+    given (the model's `equilibrium_approx`: which branch of the constraints it means), then
+    from each of DEPENDENT_STARTS in turn (a start of zero puts a pendulum in Cartesian
+    coordinates at its pivot, where the constraint's Jacobian vanishes). The first start whose iteration meets
     the constraints to 1e-12 of the coordinates' size answers a set; a set none does keeps
     its start (the equilibrium's own Newton then tries, and its residual test decides)."""
     meta = model.meta
@@ -166,11 +167,12 @@ def on_constraints(model: Model, P, q0, is_angle, max_iter: int = 50):
     fn = function(model, "constraints")
     q0 = np.array(q0, float)
     todo = np.arange(P.shape[0])
-    for start in DEPENDENT_STARTS:
+    for start in (None, *DEPENDENT_STARTS):  # None: the model's own start (equilibrium_approx) first
         if todo.size == 0:
             break
         q = q0[todo].copy()
-        q[:, dep] = start
+        if start is not None:
+            q[:, dep] = start
         for _ in range(max_iter):
             with np.errstate(all="ignore"):
                 phi, J = fn(P[todo], q)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from derive.model import Function
+from derive.model import Function, Unsupported
 
 ORDER = 10
 
@@ -20,8 +20,15 @@ def functions(d) -> list[Function]:
         fns.append(system)
     if model.equilibrium_approx:
         even_names = [str(x) for x in d.even]
+        # a symmetric zero among the equilibrium coordinates (a model with multipliers keeps
+        # every coordinate there) starts at its zero; any other must be given
+        approx = {**{c: 0 for c in model.symmetric_zero}, **model.equilibrium_approx}
+        missing = [c for c in even_names if c not in approx]
+        if missing:
+            raise Unsupported(f"{model.name}: equilibrium_approx gives no value of {', '.join(missing)} "
+                              f"(the equilibrium coordinates: {', '.join(even_names)})")
         fns.append(Function("equilibrium_approx", [("params", model.symbols)],
-                            [("qe", sp.Matrix([model.equilibrium_approx[c] for c in even_names]))],
+                            [("qe", sp.Matrix([approx[c] for c in even_names]))],
                             f"The model's approximate equilibrium of {', '.join(even_names)}, where "
                             "the runtime's Newton starts (the torsion gyrocompass's (2.2), the "
                             "gyrohorizoncompass's (3.1))."))

@@ -193,3 +193,26 @@ def test_rigid_rotor_stable_at_every_spin_and_numbered_as_frequencies(tmp_path):
     rc, text, err = run_cli("campbell", str(ROTOR_FILE), "--spin-range", "0", "1500", "--points", "16",
                             "--out", str(out), "--quiet")
     assert text.strip() == f"gyro: wrote {out} (16 spins)"
+
+
+def test_campbell_of_a_model_with_a_multiplier_is_the_hand_formula(tmp_path):
+    """tests/models/hoop_bead.py: a bead on a hoop turning at Omega, in Cartesian coordinates
+    held on the circle by a Lagrange multiplier, its bottom given as the start
+    (equilibrium_approx; the top is the constraint's other branch). By hand omega^2 =
+    g/R - Omega^2 below the critical rate sqrt(g/R) = 7.0036 rad/s, growth
+    sqrt(Omega^2 - g/R) beyond; the summary names the unstable spins."""
+    hoop = str(ROOT / "tests" / "models" / "hoop_bead.py")
+    rc, out, err = run_cli("campbell", hoop, "--spin-range", "0", "10", "--points", "11", "--json")
+    assert rc == 0, err
+    d = json.loads(out)
+    gR = 9.81 / 0.2
+    for W, (w,), (s,) in zip(d["spin_rate"], d["frequencies"], d["growth"]):
+        if W**2 < gR:
+            assert w == pytest.approx(np.sqrt(gR - W**2), rel=1e-12) and s == 0.0
+        else:
+            assert w == 0.0 and s == pytest.approx(np.sqrt(W**2 - gR), rel=1e-12)
+    rc, out, err = run_cli("campbell", hoop, "--spin-range", "0", "10", "--points", "11", "--out",
+                           str(tmp_path / "hoop.png"))
+    assert rc == 0 and "unstable at 3 of 11 spins, from 8 rad/s" in out, err
+    rc, out, _ = run_cli("frequencies", hoop, "--set", "Omega=3")
+    assert rc == 0 and "6.32850693" in out and "equilibrium: stable" in out

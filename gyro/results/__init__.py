@@ -10,8 +10,9 @@ One module per kind of result; every name is importable from `gyro.results`.
 - `sweep`: `FrequencySweep` (frequencies against any one parameter);
 - `trajectory`: `Trajectory` (the gimbal's motion: closed form or an integrator), `CoordinateMotion`
   (any model's motion from its reference, gyro/analyses/motion.py);
-- `gyrohorizoncompass`: `EquilibriumStability`, `ConditionMap` (any model's declared conditions
-  against its spectrum), `AngleTrajectory`;
+- `conditions`: `EquilibriumStability`, `ConditionMap` (any model's declared conditions
+  against its spectrum);
+- `gyrohorizoncompass`: `AngleTrajectory`;
 - `verdict`: `Verdict`, the one verdict type (stable, marginal, unstable, boundary,
   unknown, failed, each with its reason) and the two tests every analysis reads it through;
 - `sensitivity`: `Sensitivities` (d omega / d p of every frequency and parameter);
@@ -27,7 +28,8 @@ from __future__ import annotations
 
 from gyro.results._io import TMP_TAG, save_figure
 from gyro.results.campbell import FORMULA_BAD, CampbellDiagram
-from gyro.results.gyrohorizoncompass import AngleTrajectory, ConditionMap, EquilibriumStability
+from gyro.results.conditions import ConditionMap, EquilibriumStability
+from gyro.results.gyrohorizoncompass import AngleTrajectory
 from gyro.results.harmonic import ForcedResponse, HarmonicResponse
 from gyro.results.level_map import LevelMap
 from gyro.results.precession import ImagePointMotion

@@ -180,6 +180,10 @@ class ReducedState:
         from gyro.equilibrium import equilibrium
 
         meta = model.meta
+        if meta.get("constraints", {}).get("multipliers"):
+            raise ParameterError(f"{model.name}: its constraints are carried by multipliers: the reduced motion "
+                                 "(offsets of the independent coordinates alone) would leave them; not built for "
+                                 "such a model (gyro simulate integrates its full equations)")
         if any(i["name"] == "time" for i in meta["functions"]["forcing"]["inputs"]):
             raise ParameterError(f"{model.name}: its equations hold the time explicitly: no reduced motion about "
                                  "a reference (the linear motion needs autonomous equations)")

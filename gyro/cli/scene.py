@@ -79,7 +79,8 @@ def run(args) -> int:
     scene = select(model, args.question, model.vector(values), tol, opts)
     if not scene.answered[0]:
         b, lv = scene.best(0)
-        offer = f"the best bound is {b:.2e} ({lv})" if lv else "no level gives a finite bound here"
+        offer = f"the best bound is {b:.2e} ({lv})" if lv else "no level gives a finite bound here (" + "; ".join(
+            f"{name}: {why}" for name, why in scene.tried(0)) + ")"
         print(f"gyro: error: --tol {tol:g} is below what the hierarchy of {model.name} can promise "
               f"at this set; {offer}", file=sys.stderr)
         return 1

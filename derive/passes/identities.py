@@ -4,7 +4,7 @@ from __future__ import annotations
 from derive.model import Model
 
 ORDER = 50
-ROUTES = ("coordinates",)
+ROUTES = ("coordinates", "multipliers")  # a declared check runs on either route
 
 
 def run(model: Model, d):

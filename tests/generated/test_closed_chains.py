@@ -267,3 +267,17 @@ def test_coulomb_friction_equations_are_lagranges_methods():
               sp.Symbol("x"): sp.Rational(1, 10), sp.Symbol("x_d"): xd}
         assert sp.simplify((d.mass_matrix - theirs_M).xreplace(pt)) == sp.zeros(1, 1)
         assert sp.simplify((d.forcing - theirs_f).xreplace(pt)) == sp.zeros(1, 1), xd
+
+
+def test_a_model_with_multipliers_runs_its_declared_identities():
+    """A declared identity is checked on the multipliers route too (it was skipped there): a
+    residual that does not vanish stops the derivation of the bead held on its hoop by a
+    multiplier, one that does lets it through."""
+    from tests.models import hoop_bead
+
+    model = hoop_bead.build()
+    model.identities = {"the hoop's radius is positive": lambda: [0]}
+    assert pipeline.derive(model).constraints.get("multipliers")
+    model.identities = {"a residual that stays": lambda: [sp.Integer(1)]}
+    with pytest.raises(AssertionError, match="identity failed: a residual that stays"):
+        pipeline.derive(model)

@@ -189,7 +189,6 @@ def runtime_module(model, name: str) -> str:
 
     own = sys.modules.get(model.module)
     folder = Path(own.__file__).resolve().parent if own is not None and getattr(own, "__file__", None) else None
-    spec = None
     if name in sys.modules and getattr(sys.modules[name], "__file__", None):
         origin = sys.modules[name].__file__
     else:

@@ -209,7 +209,7 @@ def two_tolerances(run, rtol: float, finer: float = 1e-2):
     return q2, 2 * np.max(np.abs(q1 - q2), axis=0)
 
 
-SCIPY_METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
+SCIPY_METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")  # DOP853 first: the default
 STIFF = ("Radau", "BDF", "LSODA")  # SciPy's methods that take the Jacobian
 # SUNDIALS through CasADi: the integrator and its options (cvodes-adams: non-stiff
 # Adams-Moulton with fixed-point iteration; cvodes: BDF, CasADi's default; idas: the DAE form)
@@ -218,9 +218,12 @@ SUNDIALS = {"cvodes": ("cvodes", {}), "idas": ("idas", {}),
 
 
 def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budget_s: float = math.inf,
-                    budget_steps: float = math.inf, jac: bool = False) -> np.ndarray:
-    """States (len(t), 2n) of y' = f(y, P) (the emitted equations of motion, the inputs zero)
-    from y0 at t[0], at the times t: one integrator for every model's motions.
+                    budget_steps: float = math.inf, jac: bool = False, inputs=None, label: str | None = None
+                    ) -> np.ndarray:
+    """States (len(t), 2n) of y' = f(y, P) (the emitted equations of motion; the further
+    inputs zero, or for SciPy's methods `inputs(t)` as numpy_rhs takes it) from y0 at t[0],
+    at the times t: one integrator for every model's motions; `label` names the run in a
+    budget's message (default: the method).
 
     SciPy's METHODS (solve_ivp; with `jac` the stiff ones take the exact Jacobian), within
     `budget_s` seconds and `budget_steps` evaluations (IntegrationBudget beyond, saying how far
@@ -242,12 +245,17 @@ def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budg
             J = jacobian(model)
             zeros = [np.zeros(v.numel()) for v in symbolic(model).inputs]
             kw["jac"] = lambda _, Y: np.asarray(J(Y, ca.DM(P), *zeros)[1])
-        fun = budgeted(numpy_rhs(model, P), method, t[-1], budget_s, budget_steps, IntegrationBudget)
-        sol = solve_ivp(fun, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol, **kw)
-        if not sol.success:
-            raise FloatingPointError(f"{method}: {sol.message}")
+        fun = budgeted(numpy_rhs(model, P, inputs), label or method, t[-1], budget_s, budget_steps, IntegrationBudget)
+        with np.errstate(all="ignore"):
+            sol = solve_ivp(fun, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol, **kw)
+        if sol.status != 0 or np.shape(sol.y)[-1] != len(t):
+            reached = np.asarray(sol.t, float)  # a list where the method failed at its first step
+            raise FloatingPointError(f"{method} stopped at t = {reached[-1] if reached.size else t[0]:.6g} s: "
+                                     f"{sol.message}")
         return sol.y.T
     if method in SUNDIALS:
+        if inputs is not None:
+            raise ValueError(f"{method}: the equations' time-varying inputs are SciPy's methods' only")
         name, extra = SUNDIALS[method]
         s = symbolic(model)
         xdot = ca.substitute([s.ydot], [s.p, *s.inputs], [ca.DM(P), *[ca.DM.zeros(v.numel()) for v in s.inputs]])[0]

@@ -168,7 +168,6 @@ def balanced_radii(A: np.ndarray, M: np.ndarray):
     radii are 1e5..1e7 times these."""
     import scipy.linalg as sla
 
-    nA = A.shape[-1]
     d = 1 / np.sqrt(np.abs(np.einsum("bii->bi", M)))
     Ms = M * d[:, :, None] * d[:, None, :]
     B = np.empty_like(A)

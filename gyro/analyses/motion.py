@@ -18,7 +18,7 @@ from gyro import ode
 from gyro.errors import ParameterError
 from gyro.kernels import function
 
-METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")
+METHODS = ode.SCIPY_METHODS
 RTOL, ATOL = 1e-10, 1e-12
 BUDGET_S = 30.0
 BUDGET_EVALUATIONS = 5e6
@@ -52,10 +52,10 @@ def perturbations(model, items: dict) -> dict:
     return out
 
 
-def start(model, P, offsets: dict) -> Start:
-    """The reference state of the set P, the offsets added."""
+def start(model, P, offsets: dict, qe: np.ndarray | None = None) -> Start:
+    """The reference state of the set P, the offsets added; `qe` the set's equilibrium where
+    the caller has found it already."""
     from gyro.equilibrium import EquilibriumError, equilibria
-    from gyro.kernels import function
 
     fns = model.meta["functions"]
     if "reference_state" not in fns:
@@ -68,9 +68,11 @@ def start(model, P, offsets: dict) -> Start:
     eq_names = list(model.meta["equilibrium_coordinates"])
     args = [P]
     if eq_names:
-        qe, ok = equilibria(model, P)
-        if not ok[0]:
-            raise EquilibriumError(f"{model.name}: no equilibrium at this set: no reference to start from")
+        if qe is None:
+            qe, ok = equilibria(model, P)
+            if not ok[0]:
+                raise EquilibriumError(f"{model.name}: no equilibrium at this set: no reference to start from")
+        qe = np.asarray(qe, float).reshape(1, -1)
         args.append(qe)
     else:
         qe = np.zeros((1, 0))
@@ -134,9 +136,7 @@ def _inputs(model):
 
 
 def simulate(model, values: dict, offsets: dict, t: np.ndarray, method: str = "DOP853",
-             budget_s: float = BUDGET_S) -> "CoordinateMotion":
-    from scipy.integrate import solve_ivp
-
+             budget_s: float = BUDGET_S):
     from gyro.results.trajectory import CoordinateMotion
 
     if method not in METHODS:
@@ -148,20 +148,16 @@ def simulate(model, values: dict, offsets: dict, t: np.ndarray, method: str = "D
         raise ParameterError(f"--t-end {t[-1]:g}: the fastest motion at the start turns at {rate:.6g} 1/s, so the "
                              f"integration would need about {need:.2g} evaluations of the equations, over its budget of "
                              f"{BUDGET_EVALUATIONS:.0e}: a shorter horizon")
-    fun = ode.budgeted(ode.numpy_rhs(model, P, _inputs(model)), f"{method} on {model.name}", float(t[-1]),
-                       budget_s, BUDGET_EVALUATIONS, IntegrationBudget)
     t0 = time.perf_counter()
-    with np.errstate(all="ignore"):
-        sol = solve_ivp(fun, (0.0, float(t[-1])), st.y0, method=method, t_eval=t, rtol=RTOL, atol=ATOL)
-    if sol.status != 0 or sol.y.shape[1] != len(t):
-        raise FloatingPointError(f"{method} stopped at t = {sol.t[-1] if sol.t.size else 0.0:.6g} s: {sol.message}")
-    if not np.all(np.isfinite(sol.y)):
+    Y = ode.integrate_state(model, P, st.y0, t, method, RTOL, ATOL, budget_s, BUDGET_EVALUATIONS,
+                            inputs=_inputs(model), label=f"{method} on {model.name}")
+    if not np.all(np.isfinite(Y)):
         raise FloatingPointError("a coordinate is not finite along the motion")
     n = len(model.meta["coordinates"])
     units = model.meta.get("coordinate_units", {})
     return CoordinateMotion(model=model.name, title=model.meta.get("title", model.name), method=method, t=np.asarray(t),
                   coordinates=list(model.meta["coordinates"]), units=[units.get(c, "") for c in model.meta["coordinates"]],
-                  q=sol.y[:n].T.copy(), qd=sol.y[n:].T.copy(), params=dict(values), perturb=dict(offsets),
+                  q=Y[:, :n].copy(), qd=Y[:, n:].copy(), params=dict(values), perturb=dict(offsets),
                   equilibrium=st.equilibrium, seconds=time.perf_counter() - t0)
 
 
@@ -195,7 +191,7 @@ class ReducedState:
         self.ri = np.array([self.coords.index(c) for c in meta["reduced"]], int)
         self.ci = [self.coords.index(c) for c in meta.get("cyclic", {})]
         self.nq, self.n = len(self.coords), len(self.ri)
-        st = start(model, self.P, {})
+        st = start(model, self.P, {}, self.qe)
         self.q_ref, self.qd_ref = st.q_ref, st.qd_ref
         if self.ci and "cyclic_rates" not in meta["functions"]:
             raise ParameterError(f"{model.name}: emitted without cyclic_rates (derive it again with this version)")
@@ -249,14 +245,10 @@ class ReducedState:
         """A (2n, 2n) of z' = A z, z = (x, x'), from the generated operator at the reference."""
         from gyro.equilibrium import operators
 
-        args = (self.qe[None],) if self.qe.size else (np.zeros((1, 0)),)
-        M, D, K = (np.asarray(X, float)[0] for X in operators(self.model, self.P[None], *args))
-        n = self.n
-        A = np.zeros((2 * n, 2 * n))
-        A[:n, n:] = np.eye(n)
-        A[n:, :n] = -np.linalg.solve(M, K)
-        A[n:, n:] = -np.linalg.solve(M, D)
-        return A
+        from gyro.qep import companion_matrix
+
+        M, D, K = (np.asarray(X, float)[0] for X in operators(self.model, self.P[None], self.qe[None]))
+        return companion_matrix(M, D, K)
 
     @cached_property
     def rhs(self):

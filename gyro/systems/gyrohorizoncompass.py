@@ -376,7 +376,7 @@ def condition_map(base: dict, xaxis, yaxis, orbit: bool = False, lambda_follows:
 
 # ------------------------------------------------------------------ motions
 
-SCIPY_METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")  # gyro.ode's, DOP853 first: the default
+SCIPY_METHODS = ode.SCIPY_METHODS
 CASADI_METHODS = ("cvodes", "cvodes-adams")  # cvodes: BDF (CasADi's default); cvodes-adams: Adams-Moulton
 PROJECTED = "projected"  # fixed-step DOP853 tableau, each step projected onto E = E(0)
 METHODS = (*SCIPY_METHODS, *CASADI_METHODS, PROJECTED)

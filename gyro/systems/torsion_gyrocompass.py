@@ -174,13 +174,12 @@ class ReducedState(generic.ReducedState):
     """The full 11-coordinate state about the relative equilibrium of one set
     (gyro.analyses.motion.ReducedState): gamma3's rate from the integral C r2 = H (2.3), the
     emitted `cyclic_rates`, bit for bit the rate the frames (1.2)-(1.6) give (it replaced
-    their hand-typed form here; tests/methods/test_torsion_motion.py); k3 gamma3's index."""
+    their hand-typed form here; tests/methods/test_torsion_motion.py)."""
 
     def __init__(self, model: Model, values: dict):
         if model.name != MODEL:
             raise ParameterError(f"{model.name}: the periodic response of the full equations is {MODEL}'s only")
         super().__init__(model, values)
-        self.k3 = self.coords.index("gamma3")
 
 
 class _Periodic(ReducedState):
@@ -228,7 +227,7 @@ def nonlinear_response(model: Model, values: dict, harmonic, rtol: float = 1e-12
     S = _Periodic(model, values, harmonic)
     s, k, a, phi = harmonic
     P, values, w, T, X_lin = S.P, S.values, S.w, S.T, S.X_lin
-    coords, ri, nq, n, k3, q_ref = S.coords, S.ri, S.nq, S.n, S.k3, S.q_ref
+    ri, nq, n, q_ref = S.ri, S.nq, S.n, S.q_ref
     zero3 = np.zeros(3)
 
     def given(t):

@@ -104,7 +104,7 @@ def test_a_model_file_reaches_its_own_motion_through_its_declaration():
     rc, out, _ = run_cli("params", OWN)
     assert rc == 0
     assert "initial conditions (gyro simulate; the closed form's start):" in out and out.count("x' at t = 0") == 1
-    assert out.rstrip().endswith(f"gyro simulate oscillator_own_motion: --set x0 v0; --method closed_form (the only one)")
+    assert out.rstrip().endswith("gyro simulate oscillator_own_motion: --set x0 v0; --method closed_form (the only one)")
     rc, out, err = run_cli("simulate", OWN, "--t-end", "1", "--perturb", "x=0.1")
     assert rc == 2 and out == ""
     (line,) = error_lines(err)
@@ -166,7 +166,7 @@ def test_a_model_file_declares_a_motion_hierarchy_on_the_generic_levels():
                            "--horizon", "2", "--json")
     assert rc == 0, err
     doc = json.loads(out)
-    assert doc["level"] == "linear" and max(doc["error_bound"]) < 1e-6
+    assert doc["level"] == "linear" and max(doc["error_bound"]) <= 1e-3  # the selector's promise
     assert len(doc["alpha"]) == 201 and doc["alpha"][0] == pytest.approx(0.01, rel=1e-15)
     rc, out, err = run_cli("scene", GYROPENDULUM, "motion", "--tol", "1e-3", "--set", "psi_0=1")
     assert rc == 2 and "psi_0" in err and len(error_lines(err)) == 1

@@ -217,4 +217,4 @@ def test_the_emitted_spin_rate_is_the_integral_by_the_frames(tg):
         Y = S.state(x, xd)
         g, gd = dict(zip(S.coords, Y[:S.nq])), dict(zip(S.coords, Y[S.nq:]))
         want = values["H"] / values["C"] - _spin_free_rate(values, g, gd)
-        assert Y[S.nq + S.k3] == pytest.approx(want, rel=4 * np.finfo(float).eps)
+        assert Y[S.nq + S.coords.index("gamma3")] == pytest.approx(want, rel=4 * np.finfo(float).eps)

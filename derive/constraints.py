@@ -57,6 +57,12 @@ def _constraints(model: Model) -> list:
     return phis
 
 
+def _tidy(e):
+    """A solution entry in its simplest form: cancel, exact and cheap, for a rational
+    function of its symbols (y/R: 1 ms against simplify's 17 ms); simplify otherwise."""
+    return sp.cancel(e) if e.is_rational_function() else sp.simplify(e)
+
+
 def solve_dependent(model: Model):
     """(indices of the dependent coordinates, their solution) where the constraints are
     linear in some m coordinates with a Jacobian free of them and not identically singular
@@ -73,7 +79,7 @@ def solve_dependent(model: Model):
         if J.has(*dq) or sp.expand(J.det()) == 0:
             continue
         rest = Phi.xreplace({x: 0 for x in dq})
-        sol = (-J.LUsolve(rest)).applyfunc(sp.simplify)
+        sol = (-J.LUsolve(rest)).applyfunc(_tidy)
         return sorted(deps), dict(zip(dq, sol))
     return None
 

@@ -75,3 +75,24 @@ def test_the_constraints_pass_chooses_elimination_or_multipliers(monkeypatch, li
         assert d.route == "multipliers" and d.constraints["multipliers"] == ["lam1"]
         assert d.mass_matrix.shape == (3, 3) and d.operator.M.shape == (1, 1)
     assert d.timings and not vars(d.work)  # what passes handed on is gone
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_the_routes_check_compares_30_digit_values_either_way(monkeypatch, compiled):
+    """The two routes' check (derive/passes/operator.py) by N(entry, 30), or compiled in
+    mpmath with 60 working digits and each value rounded to 30 (large operators): equal
+    entries written differently (sin^2 + cos^2 against 1, a product against its expansion)
+    compare to exactly 0, and a term of relative size 1e-12 is seen."""
+    from derive import mechanics as mech
+    from derive.passes import operator as op_pass
+
+    monkeypatch.setattr(op_pass, "COMPILE_NODES", 0 if compiled else 10**9)
+    th, a, b = sp.symbols("theta a b")
+    M1 = sp.Matrix([[a * (sp.sin(th) ** 2 + sp.cos(th) ** 2), (a + b) ** 3], [b / (1 + sp.tan(th) ** 2), a]])
+    M2 = sp.Matrix([[a, sp.expand((a + b) ** 3)], [b * sp.cos(th) ** 2, a]])
+    K = sp.Matrix([[sp.exp(th) * a, 0], [0, b]])
+    same = op_pass.compare_operators(mech.LinearOperator(M1, M1 * 0, K), mech.LinearOperator(M2, M2 * 0, K))
+    assert same == 0.0
+    off = op_pass.compare_operators(mech.LinearOperator(M1, M1 * 0, K),
+                                    mech.LinearOperator(M2, M2 * 0, K + sp.Matrix([[0, 0], [0, b * 1e-12]])))
+    assert 1e-14 < off < 1e-11

@@ -2,7 +2,8 @@
 route 2, the second variation of the Routhian with the forces linearised (the operator
 emitted); route 1, the full equations linearised with the cyclic rates eliminated through
 their integrals. Their 30-digit comparison runs here, or beside the next passes where the
-derivation has more than one core (derive.parallel.JOBS; the agreement pass)."""
+derivation has more than one core (derive.parallel.JOBS; the agreement pass). On the
+multipliers route, the one route of the constrained system (derive/constraints.py)."""
 from __future__ import annotations
 
 import random
@@ -11,11 +12,11 @@ import mpmath
 import sympy as sp
 
 from derive import mechanics as mech
-from derive import nonsmooth, parallel
+from derive import constraints, nonsmooth, parallel
 from derive.model import Model
 
 ORDER = 90
-ROUTES = ("coordinates",)
+ROUTES = ("coordinates", "multipliers")
 
 
 def _random_point(symbols, rng):
@@ -83,6 +84,15 @@ def reduced_order(model: Model, d, E) -> list:
 
 def run(model: Model, d):
     w, signals = d.work, model.signals
+    w.check = None
+    if w.held:  # one route: the constrained linearisation (derive/constraints.py)
+        with w.steps("linear operator in the independent coordinates (sympy's linearize at rest)"):
+            held = w.held
+            E0 = (held.Mq * sp.Matrix(model.qdd) - held.f).subs(w.zero_inputs)
+            d.operator = constraints.constrained_operator(held, held.C, E0, held.f0, model.q, model.qd, model.qdd,
+                                                          held.rest)
+        d.route_agreement = None  # one route: no agreement to claim
+        return d
     at = {"at": w.zero_set, "rates": d.rates}
     with w.steps("linear operator, route 2: second variation of the Routhian, forces linearised"):
         op2 = mech.quadratic_expansion(d.routhian, d.rq, d.rqd, signals=signals, **at)

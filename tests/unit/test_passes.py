@@ -64,17 +64,25 @@ def _ran(monkeypatch, model) -> tuple[list, Derivation]:
 
 @pytest.mark.parametrize("linear", [True, False])
 def test_the_constraints_pass_chooses_elimination_or_multipliers(monkeypatch, linear):
+    """Either way every pass runs, in order: the multipliers route forms its equations,
+    reference, operator and B in the same passes as the coordinates route (with the
+    multiplier columns), so that no step added to one is silently lacking on the other."""
     ran, d = _ran(monkeypatch, _pendulum(holonomic_y=linear))
-    if linear:  # eliminated: every pass of the coordinates route, in order
-        assert ran == [m.__name__.rsplit(".", 1)[-1] for m in passes.passes() if "coordinates" in m.ROUTES]
+    assert ran == [m.__name__.rsplit(".", 1)[-1] for m in passes.passes()]
+    if linear:  # eliminated
         assert d.route == "coordinates" and d.model.coordinates == ["x"] and "eliminated" in d.constraints
-    else:  # multipliers: the constraints pass formed the equations, the operator; then only
-        # the passes of the multipliers route
-        after = [m.__name__.rsplit(".", 1)[-1] for m in passes.passes() if "multipliers" in m.ROUTES]
-        assert ran == ["conversion", "constraints"] + [n for n in after if n not in ("conversion", "constraints")]
+    else:
         assert d.route == "multipliers" and d.constraints["multipliers"] == ["lam1"]
         assert d.mass_matrix.shape == (3, 3) and d.operator.M.shape == (1, 1)
+        assert d.route_agreement is None and d.even == list(d.model.q)
     assert d.timings and not vars(d.work)  # what passes handed on is gone
+
+
+def test_every_pass_runs_on_both_routes():
+    """A pass for one route only would leave the other without its step (the multipliers
+    route once formed its equations and operator apart, without the passes' checks)."""
+    for m in passes.passes():
+        assert set(m.ROUTES) == ROUTES, m.__name__
 
 
 @pytest.mark.parametrize("compiled", [False, True])

@@ -2,11 +2,11 @@
 method on the same system, for every model of tests/models (the textbook set among them),
 each side a fresh process on one core, in one run:
 
-- ours: the model file's build() and `derive.pipeline.derive` (not `python -m derive`, which
-  imports the emitter as well) (the equations, the operator
+- ours: the model file's build() and `derive.pipeline.derive` (the equations, the operator
   by both routes and their 30-digit check, B; multipliers or elimination; the speeds'
   equations with kinematic equations; the Routh reduction and the reference): the
-  equations and the linearisation, no emission;
+  equations and the linearisation, no emission (not `python -m derive`, which imports
+  the emitter as well);
 - SymPy: LagrangesMethod(L, q, hol_coneqs, forcelist, frame).form_lagranges_equations() and
   linearize() in the independent coordinates (the dependent ones given where there are
   constraints), or, for a model in generalised speeds, KanesMethod(frame, q, u, kd_eqs)
@@ -18,7 +18,10 @@ each side a fresh process on one core, in one run:
 
 Each side's time in three parts: `import_s` (the packages and the model file, whose own
 imports are the model's), `build_s` (build(), or system() / the translation) and
-`derive_s` (the derivation alone); `whole_s` the child's wall time, interpreter included.
+`derive_s` (the derivation alone), each in wall and CPU time (`*_cpu_s`); `whole_s` the
+child's wall time, interpreter included, `whole_cpu_s` its CPU time. The ratios and the
+verdicts are in CPU time: on a shared machine the wall time is what a contended core gave
+(3-6x the CPU time in the committed run, at a load of 5 on 2 cores).
 Both sides run with their bytecode cached (PYTHONDONTWRITEBYTECODE lifted for the children,
 a cache folder of the bench's own, one uncounted run per side and system first), as an
 installed package runs: SymPy's site-packages have theirs, and a tree without (this

@@ -29,20 +29,18 @@ from __future__ import annotations
 from gyro.results._io import TMP_TAG, save_figure
 from gyro.results.campbell import FORMULA_BAD, CampbellDiagram
 from gyro.results.conditions import ConditionMap, EquilibriumStability
-from gyro.results.gyrohorizoncompass import AngleTrajectory
 from gyro.results.harmonic import ForcedResponse, HarmonicResponse
 from gyro.results.level_map import LevelMap
-from gyro.results.precession import ImagePointMotion
+from gyro.results.motion import Motion
 from gyro.results.spectrum import ModalResult, Spectrum, Stability, classify, nearest_error
 from gyro.results.scene import Scene
 from gyro.results.sensitivity import Sensitivities
 from gyro.results.stability_map import StabilityMap
 from gyro.results.sweep import FrequencySweep
 from gyro.results.tolerance import ToleranceStudy
-from gyro.results.trajectory import CoordinateMotion, Trajectory
 from gyro.results.verdict import Verdict
 
-__all__ = ["TMP_TAG", "save_figure", "FORMULA_BAD", "CampbellDiagram", "AngleTrajectory", "ConditionMap",
+__all__ = ["TMP_TAG", "save_figure", "FORMULA_BAD", "CampbellDiagram", "ConditionMap",
            "EquilibriumStability", "ModalResult", "Spectrum", "Stability", "classify", "nearest_error",
-           "StabilityMap", "FrequencySweep", "Trajectory", "CoordinateMotion", "Verdict", "Sensitivities", "ToleranceStudy",
-           "Scene", "LevelMap", "ImagePointMotion", "HarmonicResponse", "ForcedResponse"]
+           "StabilityMap", "FrequencySweep", "Motion", "Verdict", "Sensitivities", "ToleranceStudy",
+           "Scene", "LevelMap", "HarmonicResponse", "ForcedResponse"]

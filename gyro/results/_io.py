@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import os
+from contextlib import contextmanager
 from dataclasses import fields, is_dataclass
 from pathlib import Path
 
@@ -143,6 +144,37 @@ def save_figure(fig, out) -> None:
         os.replace(tmp, out)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+@contextmanager
+def _canvas(out, **figkw):
+    """The figure a plot draws into: `out` a matplotlib Figure (drawn into and left open),
+    or a path (a new figure, written there whole or not at all, then closed)."""
+    from matplotlib.figure import Figure
+
+    if isinstance(out, Figure):
+        yield out
+        return
+    plt = _pyplot()
+    fig = plt.figure(**{"layout": "constrained", **figkw})
+    try:
+        yield fig
+        save_figure(fig, out)
+    finally:
+        plt.close(fig)
+
+
+@contextmanager
+def _axes(out, **figkw):
+    """The axes a one-panel plot draws into: `out` a matplotlib Axes, a Figure (a panel
+    added) or a path (as _canvas)."""
+    from matplotlib.axes import Axes
+
+    if isinstance(out, Axes):
+        yield out
+        return
+    with _canvas(out, **figkw) as fig:
+        yield fig.add_subplot()
 
 
 def _pyplot():

@@ -12,7 +12,8 @@ from gyro import ladder, load
 from gyro.analyses import campbell
 from gyro.systems.gimbal_gyroscope import Motion, trajectory
 from gyro.analyses.stability_map import stability_grid
-from gyro.results import CampbellDiagram, ModalResult, Spectrum, StabilityMap, Trajectory
+from gyro.results import CampbellDiagram, ModalResult, Spectrum, StabilityMap
+from gyro.results import Motion as MotionResult
 
 MODEL = load("torsion_gyrocompass")
 
@@ -87,12 +88,13 @@ def test_stability_map_plots_saves_and_loads(tmp_path):
 def test_trajectory_gives_the_cli_json_saves_and_plots(method, tmp_path):
     gg = load("gimbal_gyroscope")
     tr = trajectory(Motion(gg.defaults, 1.2, 0.0, 1.0, 200.0), np.linspace(0, 0.2, 5), method)
-    assert isinstance(tr, Trajectory)
+    assert isinstance(tr, MotionResult)
     assert list(tr.to_dict()) == ["t", "theta", "psi", "phi", "method", "integrals"]
     tr.save(tmp_path / "t.npz")
-    back = Trajectory.load(tmp_path / "t.npz")
+    back = MotionResult.load(tmp_path / "t.npz")
     np.testing.assert_array_equal(back.theta, tr.theta)
     assert back.integrals == tr.integrals and back.method == method
+    assert back.to_dict() == tr.to_dict() and back.table() == tr.table()
     tr.plot(tmp_path / "t.png")
     assert (tmp_path / "t.png").exists()
 

@@ -101,6 +101,8 @@ def _jsonable(v):
         return v.tolist()
     if isinstance(v, (list, tuple)):
         return [_jsonable(x) for x in v]
+    if isinstance(v, dict):
+        return {k: _jsonable(x) for k, x in v.items()}
     if isinstance(v, (np.floating, np.integer)):
         return v.item()
     if is_dataclass(v) and not isinstance(v, type):

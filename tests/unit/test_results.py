@@ -12,7 +12,7 @@ from gyro import ladder, load
 from gyro.analyses import campbell
 from gyro.systems.gimbal_gyroscope import Motion, trajectory
 from gyro.analyses.stability_map import stability_grid
-from gyro.results import CampbellDiagram, ModalResult, Spectrum, StabilityMap
+from gyro.results import CampbellDiagram, Map, ModalResult, Spectrum
 from gyro.results import Motion as MotionResult
 
 MODEL = load("torsion_gyrocompass")
@@ -75,11 +75,11 @@ def test_campbell_diagram_plots_saves_and_pickles(tmp_path):
 
 def test_stability_map_plots_saves_and_loads(tmp_path):
     m = stability_grid(MODEL, MODEL.defaults, "l2", (-0.3, 0.3), "H", (0.1, 1.0), 4)
-    assert isinstance(m, StabilityMap) and m.label.shape == (4, 4)
+    assert isinstance(m, Map) and m.kind == "verdict" and m.label.shape == (4, 4)
     assert sum(m.counts().values()) == 16
     m.plot(tmp_path / "m.png")
     m.save(tmp_path / "m.npz")
-    back = StabilityMap.load(tmp_path / "m.npz")
+    back = Map.load(tmp_path / "m.npz")
     assert back.label.tolist() == m.label.tolist() and back.xname == "l2"
     np.testing.assert_array_equal(back.growth, m.growth)
 

@@ -39,6 +39,9 @@ class EquilibriumStability(Result):
     lines: list = field(default_factory=list)
     condition: str = ""
 
+    NO_PLOT = ("one set's margins and eigenvalues: `gyro stability` lists them (the condition Map draws the "
+               "regions over two parameters)")
+
     @property
     def boundary(self) -> bool:
         """Rounding could change the verdict: neither stable nor stabilised nor unstable."""

@@ -598,7 +598,7 @@ def trajectory(motion: Motion, t, method: str = "closed_form"):
     """theta, psi, phi at the times t by the closed form or an integrator, as a
     gyro.results.Motion (with the integrals at t = 0 and, from the closed form, the motion
     type and the period of theta in its `info`)."""
-    from gyro.results import Motion as Result
+    from gyro.results import Motion as MotionResult
 
     t = np.asarray(t, dtype=float)
     model = load(MODEL)
@@ -617,7 +617,7 @@ def trajectory(motion: Motion, t, method: str = "closed_form"):
         shown = ("none (stationary or on the separatrix)" if not math.isfinite(period) else f"{period:.9g} s")
         heading.append(f"motion: {kind}; period of theta {shown}")
     names, units, descriptions = (list(c) for c in zip(*SERIES))
-    return Result(MODEL, title, method, t, names, np.stack([theta, psi, phi], axis=1), units, descriptions,
+    return MotionResult(MODEL, title, method, t, names, np.stack([theta, psi, phi], axis=1), units, descriptions,
                   info={"integrals": I, "motion_type": kind, "period": period},
                   keys=["t", *names, "method", "integrals"], heading=heading,
                   formats={"t": ">14.6g", **{n: ">18.12g" for n in names}})

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gyro.results._io import Result, _axes, _edges, _finite_or_none
+from gyro.results._io import Result, _axes, _edges, _finite_or_none, cell
 
 KINDS = ("verdict", "condition", "error")
 
@@ -166,22 +166,25 @@ class Map(Result):
                     f"{c['gyroscopic']} spectrally stable outside it, {c['unstable']} unstable, "
                     f"{c['boundary']} within rounding of a boundary{extra})")
         i = self.info
+        finite = np.asarray(self.values)[np.isfinite(self.values)]
+        largest = f"largest error {finite.max():.3g}" if finite.size else "no point could be computed"
         return (f"gyro: wrote {out} ({c['within']} of {self.values.size} points within tol {i['tol']:g}: "
-                f"{i['level']} against {i['against']}; largest error {np.nanmax(self.values):.3g})")
+                f"{i['level']} against {i['against']}; {largest})")
 
     def table(self) -> str:
-        """The grid as text: a row per y, a column per x (an error to 3 digits, a class by its
-        label or code)."""
+        """The grid as text: a row per y, a column per x (an error to 3 digits, 'none' where
+        it could not be computed; a class by its label or code)."""
         i = self.info
         head = {"verdict": f"{self.model}: stability of the equilibrium ({', '.join(f'{v} {k}' for k, v in self.counts().items())})",
                 "condition": f"{self.model}: {self.condition_kind}",
                 "error": f"{self.model}: {i.get('measure')} of {i.get('level')} against {i.get('against')} "
                          f"(tol {i.get('tol', 0):g})"}[self.kind]
-        cell = (lambda v: f"{v:>10.3g}") if self.kind == "error" else (lambda v: f"{str(v):>10}")  # noqa: E731
+        # an error that could not be computed is 'none', never nan
+        show = (lambda v: cell(v, ">10.3g")) if self.kind == "error" else (lambda v: f"{str(v):>10}")  # noqa: E731
         corner = f"{self.yname} \\ {self.xname}"
         lines = [head, f"{corner:>22} " + " ".join(f"{v:>10.4g}" for v in self.x)]
         for k, yv in enumerate(self.y):
-            lines.append(f"{yv:>22.6g} " + " ".join(cell(v) for v in self.values[k]))
+            lines.append(f"{yv:>22.6g} " + " ".join(show(v) for v in self.values[k]))
         return "\n".join(lines)
 
     @classmethod

@@ -246,3 +246,17 @@ def test_a_campbell_diagram_loads_its_crossings_as_crossings(tmp_path):
     back = CampbellDiagram.load(tmp_path / "c.npz")
     assert all(isinstance(c, Crossing) for c in back.crossings) and back.crossings == d.crossings
     assert back.table() == d.table()
+
+
+def test_an_error_map_never_prints_nan():
+    """A point where a level could not answer is NaN in the map: its table says 'none' and
+    the summary line states no largest error where no point could be computed (it printed
+    'nan' before)."""
+    m = Map("error", "m", "t", "a", "b", np.arange(2.0), np.arange(2.0), np.array([[np.nan, 1e-3], [2e-3, np.nan]]),
+            info={"level": "x", "against": "y", "tol": 1e-2, "measure": "error", "changed": {}, "failed": {},
+                  "seconds": 0.0})
+    assert "nan" not in m.table() and "none" in m.table() and "largest error 0.002" in m.summary("f.png")
+    m.values[:] = np.nan
+    with np.errstate(all="raise"):
+        line = m.summary("f.png")
+    assert "nan" not in line and line.endswith("x against y; no point could be computed)")

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gyro.results._io import Result, _canvas, _more_rows, _shown_rows
+from gyro.results._io import Result, _canvas, _more_rows, _shown_rows, cell
 
 
 @dataclass
@@ -25,7 +25,8 @@ class Motion(Result):
       `rates`), a key of `info`, or a series (its list);
     - `table()`: `heading` (the producer's lines), then the series `shown` (default all) as
       columns formatted by `formats` (a format spec per series and for "t", as '>18.12g'),
-      joined by `gap`; up to 21 rows, else 11 spread evenly;
+      joined by `gap` (a value that is not finite as 'none'); up to 21 rows, else 11 spread
+      evenly;
     - `plot(out)`: one panel a series against t (an `invariants` one as its change from
       t = 0), after the path of the pair `path` (as the image point's x, y) where given."""
 
@@ -91,7 +92,7 @@ class Motion(Result):
         lines.append(f"{'t [s]':{width('t')}}" + "".join(f"{self.gap}{self._label(n):{width(n)}}" for n in shown))
         cols = self.block(shown)
         for i in _shown_rows(len(self.t)):
-            lines.append(f"{self.t[i]:{spec('t')}}" + "".join(f"{self.gap}{v:{spec(n)}}" for n, v in zip(shown, cols[i])))
+            lines.append(cell(self.t[i], spec("t")) + "".join(self.gap + cell(v, spec(n)) for n, v in zip(shown, cols[i])))
         return "\n".join(lines + _more_rows(len(self.t)))
 
     def plot(self, out):

@@ -30,7 +30,10 @@ class Trial(Result):
     NO_PLOT = "the selector's bookkeeping of one level: `gyro scene` lists it as the levels tried"
 
     def to_dict(self) -> dict:
-        """The level, and per set the reason it was or was not enough (null: not reached)."""
+        """The level, and per set the reason it was or was not enough (null: not reached);
+        refused for a trial without its tolerance (its reasons compare with it)."""
+        if not np.isfinite(self.tol):
+            raise ValueError(f"Trial {self.level}: no tolerance recorded, which its reasons compare with")
         return {"level": self.level, "reasons": [self.reason(k, self.tol) for k in range(len(self.code))]}
 
     def table(self) -> str:

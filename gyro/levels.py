@@ -56,10 +56,38 @@ class Level:
         return question in self.answers
 
 
+# Every model with an operator about its equilibrium and no spectrum level of its own has
+# this one: the exact operator by each method of the ladder, bounded by the method's own
+# estimate (a model written by a user answers `gyro scene MODEL frequencies` without
+# declaring a hierarchy). A model that declares a spectrum level keeps its own.
+IMPLICIT_EXACT = {
+    "name": "linear_exact",
+    "neglects": "nothing of the linearised motion about the model's equilibrium",
+    "evaluator": {"kind": "spectrum", "methods": ["polyroots", "companion", "default", "reference"],
+                  "default": "default"},
+    "answers": {"frequencies": {"estimate": True, "row": None}, "stability": {"estimate": True, "row": None}},
+    "valid": [], "cost": None, "reference": "linear_exact:reference",
+    "doc": "the exact operator about the equilibrium, by a method of the ladder (implicit: every model "
+           "with an operator and no spectrum level of its own has it)",
+}
+
+
+def declarations(model_or_meta) -> list[dict]:
+    """The level declarations of a model (its metadata's 'levels'), with IMPLICIT_EXACT
+    where the model has an operator and declares no spectrum level."""
+    from gyro.models import has_operator
+
+    meta = model_or_meta if isinstance(model_or_meta, dict) else model_or_meta.meta
+    found = list(meta.get("levels", []))
+    if has_operator(meta) and not any(d["evaluator"].get("kind") == "spectrum" for d in found):
+        found.append(IMPLICIT_EXACT)
+    return found
+
+
 def levels(model: Model) -> list[Level]:
     """The model's levels, cheapest first (ties: in the declared order)."""
     out = []
-    for d in model.meta.get("levels", []):
+    for d in declarations(model):
         ev = d["evaluator"]
         methods = ev.get("methods")
         if methods:

@@ -155,6 +155,13 @@ class Model:
         return np.array([self.vector(v) for v in batch], dtype=float)
 
 
+def has_operator(meta: dict) -> bool:
+    """A model whose operator is about a relative equilibrium of its parameters (not of
+    momenta given as inputs): what frequencies, sweeps, maps, tolerances and the implicit
+    exact level (gyro.levels) need."""
+    return "operator" in meta.get("functions", {}) and not meta.get("momenta")
+
+
 def _import_directory(directory: Path) -> str:
     """Import a generated package from a folder anywhere, under a private name."""
     import hashlib

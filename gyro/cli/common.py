@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from gyro.errors import ParameterError
+from gyro.models import has_operator  # noqa: F401  (the commands import it from here)
 
 EXIT_USAGE = 2
 COMMAND_BUDGET = 60.0  # s: a command's batch in this process (gyro.executor.budget), refused beyond
@@ -31,10 +32,6 @@ class Parser(argparse.ArgumentParser):
         sys.exit(EXIT_USAGE)
 
 
-def has_operator(meta: dict) -> bool:
-    """A model whose operator is about a relative equilibrium of its parameters (not of
-    momenta given as inputs): what frequencies, sweeps, maps and tolerances need."""
-    return "operator" in meta.get("functions", {}) and not meta.get("momenta")
 
 
 def has_spin(meta: dict) -> bool:

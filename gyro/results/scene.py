@@ -159,7 +159,7 @@ class Scene(Result):
         for key, val in d.items():
             if key not in ("model", "question", "tol", "level", "tried", "frequencies", vkey, "quantities",
                            "error_bound", "seconds", "t", *self._long_keys(d)):
-                lines.append(f"{key}: {val}")
+                lines.append(f"{key}: {_shown(val)}")
         lines.append(f"answered in {self.seconds:.3g} s")
         return "\n".join(lines)
 
@@ -167,3 +167,17 @@ class Scene(Result):
     def _long_keys(d: dict) -> list:
         """Keys whose values are long lists (a motion's samples): JSON only."""
         return [k for k, v in d.items() if isinstance(v, list) and len(v) > 12 and k != "tried"]
+
+
+def _shown(val) -> str:
+    """A document's value as text: a mapping as `key value, ...`, a list as `a, b, ...`
+    (numbers by :g, None as none), anything else as str."""
+    if isinstance(val, dict):
+        return ", ".join(f"{k} {_shown(v)}" for k, v in val.items())
+    if isinstance(val, (list, tuple)):
+        return ", ".join(_shown(v) for v in val)
+    if val is None:
+        return "none"
+    if isinstance(val, float):
+        return f"{val:g}"
+    return str(val)

@@ -254,6 +254,11 @@ def _operator_dim(model_name: str) -> int:
     return next(o["shape"][0] for o in outs if o["name"] == "M")
 
 
+def _dimension(model_name: str) -> int:
+    """The dimension of a model's operator, 0 where it has none."""
+    return _operator_dim(model_name) if "operator" in load(model_name).meta["functions"] else 0
+
+
 def _qep_kernel(model_name: str, symbol: str):
     """(entry point, n, group) of the quadratic eigenproblem's kernels for a model with an
     operator (M, D, K) of dimension n >= 2: the library of its dimension, and its operator's
@@ -261,7 +266,7 @@ def _qep_kernel(model_name: str, symbol: str):
     or None where it has none). CompilerUnavailable for a model without one, so that
     callers take their NumPy paths."""
     meta = load(model_name).meta
-    n = _operator_dim(model_name) if "operator" in meta["functions"] else 0
+    n = _dimension(model_name)
     if n < 2:
         raise CompilerUnavailable(f"{model_name}: no operator of dimension 2 or more for the kernels")
     form = meta.get("operator_real_form")
@@ -271,6 +276,14 @@ def _qep_kernel(model_name: str, symbol: str):
     fn = getattr(kernel_library("qep", n), symbol)
     fn.restype = None
     return fn, n, group
+
+
+def kernel_libraries(model_name: str) -> list:
+    """The kernels' libraries a model takes, built on first use: those of its operator's
+    dimension where it has one of 2 or more, and the polynomial roots (for a warm cache:
+    tests/conftest.py builds them before the tests, as it builds the models' C)."""
+    n = _dimension(model_name)
+    return ([kernel_library("qep", n)] if n >= 2 else []) + [kernel_library("polyroots")]
 
 
 def _group_ptr(group):

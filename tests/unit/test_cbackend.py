@@ -151,3 +151,18 @@ print(json.dumps({"none": all(k is None for k in kinds), "f": s.frequencies.toli
         z = roots.roots(np.array([[2.0, -3.0, 1.0], [1.0, 0.0, 1.0]]), m)[0]
     assert got["f"] == s.frequencies.tolist() and got["e"] == s.error_estimate.tolist()
     assert got["z"] == [[x.real, x.imag] for x in z.ravel()]
+
+
+def test_the_generated_c_holds_no_kernel_and_the_input_hash_none_of_their_sources():
+    """The kernels live in gyro/csrc alone: no model's C defines one of their entry points,
+    and no kernel source is among the files each model's input hash covers."""
+    import re
+
+    from derive.emit import machinery_files
+    from gyro.catalog import available
+    from tests.conftest import GENERATED
+
+    assert not [f for f in machinery_files() if cbackend.CSRC in f.parents]
+    entry = re.compile(r"\w+_(qep_refine|qep_block_starts|qep_hermitian|sens_null_vectors|sens_contract|poly_roots)_batch\b")
+    for name in available():
+        assert not entry.search((GENERATED / name / f"{name}.c").read_text()), name

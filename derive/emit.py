@@ -547,8 +547,9 @@ def check_names(functions: list[Function]) -> None:
 
 
 def _operator_dim(functions: list[Function]) -> int:
-    """Dimension n of the model's operator (M, D, K), when it has one of n >= 2: the C then
-    also gets the root refinement of its quadratic eigenproblem (templates/qep.c.j2)."""
+    """Dimension n of the model's operator (M, D, K), when it has one of n >= 2: the runtime
+    then takes the kernels of that dimension (gyro/csrc/), and metadata.json gives them the
+    operator's real form ("operator_real_form")."""
     n = max((m.rows for fn in functions if fn.name == "operator" for _, m in fn.outputs), default=0)
     return n if n >= 2 else 0
 
@@ -726,8 +727,7 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
     emitted = {k: [d[k] for d in done] for k in printers}
     source = _shown(module_file)
     common = dict(model=model.name, title=model.title, paper=model.source, source=source,
-                  digest=digest, versions=tool_versions(), prefix=model.name, qep_n=_operator_dim(functions),
-                  real_form=_real_form(functions),
+                  digest=digest, versions=tool_versions(), prefix=model.name,
                   select=_mode_select(functions))
     common["newton"] = _newton(emitted["c"], metadata)
     if common["select"]:
@@ -749,6 +749,8 @@ def emit(model, functions: list[Function], metadata: dict, outdir: Path, steps=N
     meta = dict(metadata)
     meta["generated"] = {"by": "derive", "source": source, "input_hash": digest,
                          "versions": tool_versions()}
+    if _operator_dim(functions):  # the kernels' one table from the model (gyro.cbackend)
+        meta["operator_real_form"] = _real_form(functions)
     # inputs and outputs as lists, in call order: every backend reads the order from here;
     # a sparse output keeps its matrix's shape and gives the positions of its values
     meta["functions"] = {

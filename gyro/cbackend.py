@@ -1,10 +1,19 @@
-"""The generated C of a model, compiled once per machine and called over a batch.
+"""The generated C of a model and the model-free kernels, compiled once per machine and
+called over a batch.
 
 `make derive` emits `<model>.c` with a `<name>_batch(n, inputs..., outputs...)` entry point
 per function. Here gcc turns it into a shared library, cached under $GYRO_CACHE (default
 ~/.cache/gyro-dynamics) by the hash of the source and the flags, and ctypes calls it on
 contiguous NumPy arrays: one call per batch, no Python per set. ISO C99 keeps
 -ffp-contract=off, so the results are those of the source's operations as written.
+
+The numerics that know no model (the quadratic eigenproblem's refinement and starts, the
+roots' sensitivities, polynomial roots: gyro/csrc/, their entry points in kernels.h) are
+C sources of this package, compiled the same way into a library of their own, once per
+operator dimension (-DQEP_N=n: a constant to the compiler, as when they were rendered into
+each model's C) and loaded beside the model's library: they take the arrays its functions
+give, and a model's structure as data (its operator's real form, from metadata.json). A fix
+to a kernel rebuilds one library per dimension, no model's.
 """
 from __future__ import annotations
 
@@ -113,20 +122,60 @@ def _intact(so: Path) -> bool:
 @lru_cache(maxsize=None)
 def _library(directory: str, model_name: str) -> ctypes.CDLL:
     src = Path(directory) / f"{model_name}.c"
-    hdr = src.with_suffix(".h")
+    return _shared(model_name, (src,), (src.with_suffix(".h"),), notice=f"the generated C of {model_name}")
+
+
+CSRC = Path(__file__).resolve().parent / "csrc"
+# the kernels' libraries: their sources in gyro/csrc/ (every header there is part of each)
+KERNELS = {"qep": ("qep.c", "qep_starts.c", "sensitivity.c"), "polyroots": ("polyroots.c",)}
+
+
+def kernel_library(kind: str, n: int | None = None) -> ctypes.CDLL:
+    """The compiled kernels of one kind (KERNELS), for operators of dimension n where they
+    need one: built on first use, once per (kind, n, sources, compiler, flags, machine),
+    shared by every model of that dimension."""
+    _available()
+    return _kernel_library(str(CSRC), kind, n)
+
+
+@lru_cache(maxsize=None)
+def _kernel_library(folder: str, kind: str, n: int | None) -> ctypes.CDLL:
+    folder = Path(folder)
+    sources = tuple(folder / f for f in KERNELS[kind])
+    defines = () if n is None else (f"-DQEP_N={int(n)}",)
+    stem = f"kernel-{kind}" + ("" if n is None else f"-n{int(n)}")
+    what = " ".join(KERNELS[kind]) + "".join(f" {d}" for d in defines)
+    return _shared(stem, sources, tuple(sorted(folder.glob("*.h"))), defines,
+                   notice=f"the generated C's kernels ({what})")
+
+
+def _key(cc: str, sources, headers, defines) -> str:
+    """The cache key of a library: its files (names and bytes), the compiler, the flags,
+    the macros and the machine."""
+    h = hashlib.sha256()
+    for f in (*sources, *headers):
+        h.update(f.name.encode() + b"\0" + f.read_bytes() + b"\0")
+    h.update(" ".join((cc,) + FLAGS + tuple(defines) + (os.uname().machine,)).encode())
+    return h.hexdigest()[:16]
+
+
+def _shared(stem: str, sources, headers, defines=(), notice: str = "") -> ctypes.CDLL:
+    """The shared library of sources (with headers, macros), compiled once per machine into
+    the cache as <stem>-<key>.so, saying `notice` on stderr when it compiles (every notice
+    starts "the generated C": tests/conftest.py's NOTICES); CompilerUnavailable without a
+    compiler or where it fails."""
     cc = os.environ.get("CC", "gcc")
     if shutil.which(cc) is None:
         raise CompilerUnavailable(f"no C compiler {cc!r} on PATH")
-    key = hashlib.sha256(src.read_bytes() + hdr.read_bytes()
-                         + " ".join((cc,) + FLAGS + (os.uname().machine,)).encode()).hexdigest()[:16]
+    key = _key(cc, sources, headers, defines)
     if key in _FAILED:
         raise _FAILED[key]
-    name = f"{model_name}-{key}.so"
+    name = f"{stem}-{key}.so"
     out = cache_dir() / name
     if not _intact(out):  # missing, truncated or overwritten: built again (where writable)
         out = _writable_cache() / name
         if not _intact(out):
-            _build(cc, src, out, key)
+            _build(cc, sources, out, key, defines, notice)
     try:
         return ctypes.CDLL(str(out))
     except OSError as exc:  # sealed but unloadable: remembered, and the NumPy paths answer
@@ -134,20 +183,22 @@ def _library(directory: str, model_name: str) -> ctypes.CDLL:
         raise _FAILED[key] from None
 
 
-def _build(cc: str, src: Path, out: Path, key: str) -> None:
-    """Compile src into out (atomically, with its seal), saying so on stderr: the first run
-    on a machine takes some seconds here."""
+def _build(cc: str, sources, out: Path, key: str, defines=(), notice: str = "") -> None:
+    """Compile sources into out (atomically, with its seal), saying so on stderr: the first
+    run on a machine takes some seconds here. Two processes building the same library at
+    once each compile into a folder of their own and rename into place: the last rename
+    wins, and either file is whole."""
     import subprocess
     import tempfile
 
-    print(f"gyro: compiling the generated C of {src.stem} once for this machine (into {out.parent}) ...",
-          file=sys.stderr, flush=True)
+    what = " ".join(s.name for s in sources) + "".join(f" {d}" for d in defines)
+    print(f"gyro: compiling {notice} once for this machine (into {out.parent}) ...", file=sys.stderr, flush=True)
     with tempfile.TemporaryDirectory(dir=out.parent) as tmp:
         tmp_so = Path(tmp) / out.name
-        proc = subprocess.run([cc, *FLAGS, "-I", str(src.parent), str(src), "-o", str(tmp_so), "-lm"],
-                              capture_output=True, text=True)
+        proc = subprocess.run([cc, *FLAGS, *defines, "-I", str(sources[0].parent), *map(str, sources),
+                               "-o", str(tmp_so), "-lm"], capture_output=True, text=True)
         if proc.returncode != 0:  # remembered: one failed build per process, not one per call
-            _FAILED[key] = CompilerUnavailable(f"{cc} failed on {src.name}: {proc.stderr.strip()[:500]}")
+            _FAILED[key] = CompilerUnavailable(f"{cc} failed on {what}: {proc.stderr.strip()[:500]}")
             raise _FAILED[key]
         seal = Path(tmp) / "seal"
         seal.write_text(_digest(tmp_so) + "\n")
@@ -203,6 +254,42 @@ def _operator_dim(model_name: str) -> int:
     return next(o["shape"][0] for o in outs if o["name"] == "M")
 
 
+def _dimension(model_name: str) -> int:
+    """The dimension of a model's operator, 0 where it has none."""
+    return _operator_dim(model_name) if "operator" in load(model_name).meta["functions"] else 0
+
+
+def _qep_kernel(model_name: str, symbol: str):
+    """(entry point, n, group) of the quadratic eigenproblem's kernels for a model with an
+    operator (M, D, K) of dimension n >= 2: the library of its dimension, and its operator's
+    real form (metadata.json "operator_real_form": 0 or 1 per coordinate, as a C int array,
+    or None where it has none). CompilerUnavailable for a model without one, so that
+    callers take their NumPy paths."""
+    meta = load(model_name).meta
+    n = _dimension(model_name)
+    if n < 2:
+        raise CompilerUnavailable(f"{model_name}: no operator of dimension 2 or more for the kernels")
+    form = meta.get("operator_real_form")
+    group = None if form is None else np.ascontiguousarray(form, dtype=np.intc)
+    _check(group is None or (group.shape == (n,) and bool(np.all((group == 0) | (group == 1)))),
+           f"operator_real_form must be {n} groups, each 0 or 1")
+    fn = getattr(kernel_library("qep", n), symbol)
+    fn.restype = None
+    return fn, n, group
+
+
+def kernel_libraries(model_name: str) -> list:
+    """The kernels' libraries a model takes, built on first use: those of its operator's
+    dimension where it has one of 2 or more, and the polynomial roots (for a warm cache:
+    tests/conftest.py builds them before the tests, as it builds the models' C)."""
+    n = _dimension(model_name)
+    return ([kernel_library("qep", n)] if n >= 2 else []) + [kernel_library("polyroots")]
+
+
+def _group_ptr(group):
+    return None if group is None else group.ctypes.data_as(ctypes.POINTER(ctypes.c_int))
+
+
 def _check(cond: bool, what: str) -> None:
     """Shapes are checked before C sees the arrays: a mismatch would read out of bounds."""
     if not cond:
@@ -214,12 +301,11 @@ def batch_function(model_name: str, fname: str) -> BatchFunction:
 
 
 class QepRefine:
-    """The generated root refinement of the operator's quadratic eigenproblem
-    (templates/qep.c.j2; gyro.ladder._rayleigh_step root by root, in C)."""
+    """The root refinement of the operator's quadratic eigenproblem (gyro/csrc/qep.c;
+    gyro.ladder._rayleigh_step root by root, in C)."""
 
     def __init__(self, model_name: str):
-        self._fn = _entry(model_name, f"{model_name}_qep_refine_batch")
-        self.n = _operator_dim(model_name)
+        self._fn, self.n, self.group = _qep_kernel(model_name, "gyro_qep_refine_batch")
 
     def __call__(self, M, D, K, w, z, iters: int, tol: float, overwrite: bool = False):
         """M, D, K (sets, n, n); w (sets, r) and z (sets, r, n) complex: the starts. Returns
@@ -237,7 +323,7 @@ class QepRefine:
         est, ok = np.empty(w.shape), np.empty(w.shape)
         ptr = ctypes.POINTER(ctypes.c_double)
         self._fn(ctypes.c_long(w.shape[0]), ctypes.c_long(w.shape[1]), ctypes.c_long(iters),
-                 ctypes.c_double(tol), *[a.ctypes.data_as(ptr) for a in (M, D, K, w, z, est, ok)])
+                 ctypes.c_double(tol), _group_ptr(self.group), *[a.ctypes.data_as(ptr) for a in (M, D, K, w, z, est, ok)])
         return w, z, est, ok.astype(bool)
 
 
@@ -247,12 +333,11 @@ def qep_refine(model_name: str) -> QepRefine:
 
 
 class QepHermitian:
-    """The generated Hermitian form of a diagonal block of the operator (templates/qep.c.j2;
+    """The Hermitian form of a diagonal block of the operator (gyro/csrc/qep.c;
     gyro.qep.hermitian_block's matrix T, in C)."""
 
     def __init__(self, model_name: str):
-        self._fn = _entry(model_name, f"{model_name}_qep_hermitian_batch")
-        self.n = _operator_dim(model_name)
+        self._fn, self.n, _ = _qep_kernel(model_name, "gyro_qep_hermitian_batch")
 
     def __call__(self, M, D, K, idx):
         """M, D, K (sets, n, n), idx the block's indices. Returns (T, ok): T (sets, 2nb, 2nb)
@@ -276,13 +361,12 @@ def qep_hermitian(model_name: str) -> QepHermitian:
 
 
 class QepBlockStarts:
-    """The generated starts of the refinement (templates/qep_starts.c.j2): per diagonal block,
-    the Hermitian form's eigenvalues without LAPACK and a vector per root by inverse
-    iteration on the block (gyro.qep.block_starts' NumPy path, in C)."""
+    """The starts of the refinement (gyro/csrc/qep_starts.c): per diagonal block, the
+    Hermitian form's eigenvalues without LAPACK and a vector per root by inverse iteration
+    on the block (gyro.qep.block_starts' NumPy path, in C)."""
 
     def __init__(self, model_name: str):
-        self._fn = _entry(model_name, f"{model_name}_qep_block_starts_batch")
-        self.n = _operator_dim(model_name)
+        self._fn, self.n, self.group = _qep_kernel(model_name, "gyro_qep_block_starts_batch")
 
     def __call__(self, M, D, K, blocks, rhs):
         """M, D, K (sets, n, n); blocks a partition of 0..n-1 into index arrays; rhs (n,)
@@ -299,7 +383,8 @@ class QepBlockStarts:
         w, z, ok = np.empty((N, n)), np.empty((N, n, n), complex), np.empty(N)
         ptr, lptr = ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_long)
         self._fn(ctypes.c_long(N), ctypes.c_long(len(blocks)), sizes.ctypes.data_as(lptr),
-                 idx.ctypes.data_as(lptr), *[a.ctypes.data_as(ptr) for a in (rhs, M, D, K, w, z, ok)])
+                 idx.ctypes.data_as(lptr), _group_ptr(self.group),
+                 *[a.ctypes.data_as(ptr) for a in (rhs, M, D, K, w, z, ok)])
         return w, z, ok.astype(bool)
 
 
@@ -403,11 +488,12 @@ def mode_formulas_selected(model_name: str) -> ModeFormulasSelected:
 
 
 class PolyRoots:
-    """The generated polynomial roots with inclusion radii (templates/polyroots.c.j2;
-    gyro.roots in C), in any model's library: it knows no model."""
+    """The polynomial roots with inclusion radii (gyro/csrc/polyroots.c; gyro.roots in C):
+    it knows no model, one library for all."""
 
     def __init__(self, model_name: str):
-        self._fn = _entry(model_name, f"{model_name}_poly_roots_batch")
+        self._fn = kernel_library("polyroots").gyro_poly_roots_batch
+        self._fn.restype = None
 
     def __call__(self, c):
         """c (sets, degree + 1), lowest first. Returns (z complex, relative radius, relative
@@ -422,17 +508,17 @@ class PolyRoots:
 
 
 def poly_roots(model_name: str) -> PolyRoots:
-    """The compiled polynomial roots of a model's library (CompilerUnavailable without one)."""
+    """The compiled polynomial roots (CompilerUnavailable without a compiler); the model
+    only keys the instance, as every kernel's."""
     return _built(PolyRoots, model_name)
 
 
 class SensitivityNullVectors:
-    """The generated null vectors of the roots (templates/sensitivity.c.j2;
+    """The null vectors of the roots (gyro/csrc/sensitivity.c;
     gyro.analyses.sensitivity._null_vectors with one LU per root, in C)."""
 
     def __init__(self, model_name: str):
-        self._fn = _entry(model_name, f"{model_name}_sens_null_vectors_batch")
-        self.n = _operator_dim(model_name)
+        self._fn, self.n, _ = _qep_kernel(model_name, "gyro_sens_null_vectors_batch")
 
     def __call__(self, M, D, K, lam, hermitian, rhs):
         """M, D, K (sets, n, n); lam (sets, r) complex roots; hermitian (sets,); rhs (n,)
@@ -459,12 +545,11 @@ def sens_null_vectors(model_name: str) -> SensitivityNullVectors:
 
 
 class SensitivityContract:
-    """The generated contraction of the roots' sensitivities over the structural nonzeros
-    of the operator's Jacobian (templates/sensitivity.c.j2)."""
+    """The contraction of the roots' sensitivities over the structural nonzeros of the
+    operator's Jacobian (gyro/csrc/sensitivity.c)."""
 
     def __init__(self, model_name: str):
-        self._fn = _entry(model_name, f"{model_name}_sens_contract_batch")
-        self.n = _operator_dim(model_name)
+        self._fn, self.n, _ = _qep_kernel(model_name, "gyro_sens_contract_batch")
 
     def __call__(self, rows, cols, ncols, vals, M, D, lam, x, y):
         """rows, cols (nnz,): positions in the layout (3 n^2, ncols); vals (sets, nnz); M, D

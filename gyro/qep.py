@@ -2,8 +2,8 @@
 the companion (first-order) eigensolver, Newton's iteration on J(lambda) through its
 singular vectors, the Hermitian block form of a gyroscopic block with K > 0, and inverse
 iteration with the Rayleigh functional on J(i omega). The frequency methods of
-gyro.methods are built from these; compiled twins of the batched pieces are generated from
-templates/qep.c.j2 and dispatched by gyro.kernels.
+gyro.methods are built from these; compiled twins of the batched pieces are the kernels of
+gyro/csrc/ (qep.c, qep_starts.c), dispatched by gyro.kernels.
 """
 from __future__ import annotations
 
@@ -294,7 +294,7 @@ def rayleigh_step(M, D, K, w, z):
 
 def rayleigh(model: Model, M, D, K, w, z, iters, tol, chunk=256, overwrite=False):
     """Steps of rayleigh_step on every root until its estimate is <= tol (at most `iters`).
-    Compiled: the model's generated refinement (templates/qep.c.j2), root by root (with
+    Compiled: the refinement of the model's dimension (gyro/csrc/qep.c), root by root (with
     overwrite, in the caller's w and z where their layout allows: no copy of the vectors).
     Without a compiler: rayleigh_step on every root, in chunks of sets (cache-sized), then
     further steps only on the roots whose estimate still exceeds tol. Returns (w, z,
@@ -553,7 +553,7 @@ def block_starts(model: Model, M, D, K, good):
     entry far from overflow as gyro.equilibrium.tame has it; K > 0 and
     M > 0 in every diagonal block, with a margin) and, for those, the block problems' frequencies (sets taken, n) and a vector
     per root (sets taken, n, n): the starts of the refinement. Compiled: the model's
-    generated block forms and their eigenvalues without LAPACK (templates/qep_starts.c.j2),
+    block forms and their eigenvalues without LAPACK (gyro/csrc/qep_starts.c),
     whose Cholesky pivots must exceed 1e3 eps; without a compiler: the same test on the
     leading principal minors (pivots_above), hermitian_block and block_vectors."""
     kernel = compiled(cbackend.qep_block_starts, model)

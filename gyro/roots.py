@@ -122,7 +122,7 @@ def radii(c: np.ndarray, z: np.ndarray) -> np.ndarray:
 def roots(c: np.ndarray, model=None):
     """(z, relative inclusion radius, proven) of the polynomials c (sets, degree + 1),
     lowest coefficient first (module docstring). With a model, its compiled library's
-    version (templates/polyroots.c.j2) where there is a compiler; NumPy otherwise."""
+    version (gyro/csrc/polyroots.c) where there is a compiler; NumPy otherwise."""
     c = np.asarray(c, dtype=float)
     N, d1 = c.shape
     d = d1 - 1

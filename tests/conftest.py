@@ -55,6 +55,7 @@ def pytest_sessionstart(session):
     for name in available():
         try:
             cbackend.library(name)
+            cbackend.kernel_libraries(name)  # gyro/csrc, once per operator dimension
         except cbackend.CompilerUnavailable:
             pass  # the tests that need the compiler say so themselves
 

@@ -434,42 +434,6 @@ void gimbal_precession_spin_from_momentum_batch(long n, const double *params, co
 void gimbal_precession_spin_from_momentum_varying(const double *params, const double *angles, const double *rates, const double *momentum, const double *signals, double *out_phi_d);
 void gimbal_precession_spin_from_momentum_varying_batch(long n, const double *params, const double *angles, const double *rates, const double *momentum, const double *signals, double *out_phi_d);
 
-/* Refinement of the natural frequencies of the operator (M, D, K), 3x3: r roots per set,
- * started at w[nsets*r] with vectors z[nsets*r*3] (complex, interleaved), refined in place;
- * est[nsets*r]: relative error estimate; ok[nsets*r]: 1 where the step succeeded. */
-void gimbal_precession_qep_refine_batch(long nsets, long r, long iters, double tol,
-                                   const double *M, const double *D, const double *K,
-                                   double *w, double *z, double *est, double *ok);
-
-/* The Hermitian form T (nsets, 2nb, 2nb; complex, interleaved) of the diagonal block idx[nb]
- * of each operator, whose eigenvalues are 1/w; ok[nsets]: 1 where K and M of the block are
- * positive definite with a margin. */
-void gimbal_precession_qep_hermitian_batch(long nsets, long nb, const long *idx, const double *M,
-                                      const double *D, const double *K, double *T, double *ok);
-
-/* Starts of every root (templates/qep_starts.c.j2): w[nsets*3] from the Hermitian block
- * forms' eigenvalues, z[nsets*3*3] (complex, interleaved) a unit vector per root by
- * inverse iteration on its block from rhs; ok[nsets] where every block took the Hermitian path. */
-void gimbal_precession_qep_block_starts_batch(long nsets, long nblocks, const long *sizes, const long *idx,
-                                         const double *rhs, const double *M, const double *D,
-                                         const double *K, double *w, double *z, double *ok);
-
-/* Null vectors of the roots (templates/sensitivity.c.j2): for r roots lam[nsets*r] (complex,
- * interleaved) of each operator, x and y[nsets*r*3] (complex) unit right and left null vectors
- * of J(lam (1 + 1e-15)) by one step of inverse iteration from rhs, both from one LU; y = x where
- * hermitian[k]; singular[nsets*r]: 1 where a pivot is exactly zero (x, y then zero). */
-void gimbal_precession_sens_null_vectors_batch(long nsets, long r, const double *M, const double *D,
-                                          const double *K, const double *lam, const double *hermitian,
-                                          const double *rhs, double *x, double *y, double *singular);
-
-/* The contraction of the roots' sensitivities over the nnz structural nonzeros (rows, cols) of
- * dJ/dw, values vals[nsets*nnz]: h[nsets*r*ncols] (complex) the sums of conj(y) dJ/dw_c x per
- * column c, den[nsets*r] (complex) y* (2 M lam + D) x. */
-void gimbal_precession_sens_contract_batch(long nsets, long r, long nnz, long ncols, const long *rows,
-                                      const long *cols, const double *vals, const double *M,
-                                      const double *D, const double *lam, const double *x,
-                                      const double *y, double *h, double *den);
-
 /* Relative equilibria by Newton's method (templates/equilibrium.c.j2): from qe[nsets*2], the
  * starts, iterated in place, at most max_iter steps, angle steps scaled to max_angle_step;
  * status[nsets]: 1 converged to tol, 2 handed back to the NumPy iteration (an entry of r or

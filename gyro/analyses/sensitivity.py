@@ -16,7 +16,7 @@ structural nonzeros, their positions in metadata.json), or, for a model emitted 
 from CasADi's algorithmic differentiation of the emitted `operator` and
 `equilibrium_residual` (`route='casadi'`). Both are exact (no step size); bench/scale.py
 measures which is faster. The null vectors (one LU of J per root) and the contraction over
-the nonzeros are compiled with the model's C (templates/sensitivity.c.j2), with NumPy the
+the nonzeros are compiled C (gyro/csrc/sensitivity.c), with NumPy the
 fallback that gives the same numbers.
 
 A double or nearly double root has no derivative (it is not differentiable where two roots

@@ -9,8 +9,8 @@ functional z* J(i omega) z = 0 (a quadratic in omega). Its estimate is a residua
 plus the rounding floor of evaluating J. Sets where a block's K is not positive definite,
 roots leave the real axis, two roots merge, or the estimate exceeds the tolerance,
 escalate by themselves: first to the general companion solver with Newton refinement,
-then to ``reference``. The block forms and the refinement run as the model's generated C
-(templates/qep.c.j2), set by set and root by root in one call per batch; without a
+then to ``reference``. The block forms and the refinement run as compiled C (gyro/csrc/,
+the kernels of the model's dimension), set by set and root by root in one call per batch; without a
 compiler, as NumPy.
 """
 from __future__ import annotations

@@ -51,6 +51,12 @@ def test_the_wheel_carries_the_runtime_and_the_generated_models_only(installed):
         for f in ("metadata.json", f"{model}.c", f"{model}.h", "numpy_functions.py", "mpmath_functions.py"):
             assert f"gyro/generated/{model}/{f}" in names, f
     assert not [n for n in names if n.startswith(("derive/", "generated/", "tests/", "bench/"))]
+    # the kernels' C sources, compiled on the user's machine once per operator dimension
+    from gyro import cbackend
+
+    sources = {f.name for f in cbackend.CSRC.iterdir() if f.suffix in (".c", ".h")}
+    assert {f for fs in cbackend.KERNELS.values() for f in fs} <= sources
+    assert sorted(f"gyro/csrc/{f}" for f in sources if f"gyro/csrc/{f}" not in names) == []
     assert any(n.endswith(".dist-info/licenses/LICENSE") or n.endswith("LICENSE") for n in names)
 
 

@@ -376,16 +376,30 @@ def test_c_printer_parenthesises_powers_in_denominators():
         assert abs(got / want - 1) < 1e-14, (e, pr.doprint(e))
 
 
-@pytest.mark.parametrize("name", [m for m in MODELS if "QEP_N" in (GENERATED / m / f"{m}.c").read_text()])
-def test_c_compiles_without_warnings_under_the_runtime_flags(name, tmp_path):
+def _builds():
+    """What the runtime compiles: every model's C, the kernels of each operator dimension
+    the models have (gyro.cbackend.KERNELS, -DQEP_N=n) and the polynomial roots."""
+    from gyro import cbackend
+
+    dims = sorted({next(o["shape"][0] for o in m["functions"]["operator"]["outputs"] if o["name"] == "M") for m in
+                   (json.loads((GENERATED / name / "metadata.json").read_text()) for name in MODELS)
+                   if "operator_real_form" in m})
+    return ([pytest.param([GENERATED / name / f"{name}.c"], (), id=name) for name in MODELS]
+            + [pytest.param([cbackend.CSRC / f for f in cbackend.KERNELS["qep"]], (f"-DQEP_N={n}",), id=f"qep-n{n}")
+               for n in dims]
+            + [pytest.param([cbackend.CSRC / f for f in cbackend.KERNELS["polyroots"]], (), id="polyroots")])
+
+
+@pytest.mark.parametrize("sources, defines", _builds())
+def test_c_compiles_without_warnings_under_the_runtime_flags(sources, defines, tmp_path):
     """The runtime's own flags (gyro.cbackend.FLAGS: -O3 -march=native, where the compiler
     sees the lanes as this machine's vectors and warns of what it cannot prove initialised)
-    with -Wall -Wextra -Werror -pedantic: a user building with warnings as errors builds."""
+    with -Wall -Wextra -Werror -pedantic: a user building with warnings as errors builds,
+    a model's C and the kernels of every dimension the models have alike."""
     from gyro import cbackend
 
     cc = shutil.which("gcc") or shutil.which("cc")
-    src = GENERATED / name / f"{name}.c"
-    cmd = [cc, *cbackend.FLAGS, "-Wall", "-Wextra", "-Werror", "-pedantic", "-I", str(src.parent),
-           str(src), "-o", str(tmp_path / f"{name}.so"), "-lm"]
+    cmd = [cc, *cbackend.FLAGS, *defines, "-Wall", "-Wextra", "-Werror", "-pedantic", "-I", str(sources[0].parent),
+           *map(str, sources), "-o", str(tmp_path / "lib.so"), "-lm"]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr[:2000]

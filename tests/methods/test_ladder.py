@@ -381,7 +381,7 @@ def _without_compiler(monkeypatch) -> list:
 
 
 def test_compiled_kernels_agree_with_the_numpy_path(monkeypatch):
-    """The generated C (templates/qep.c.j2) and the NumPy path of the default method are the
+    """The compiled C (gyro/csrc/qep.c) and the NumPy path of the default method are the
     same algorithm: on the edges above they take the same route, and their frequencies agree
     to far below the tolerance (their LU factorisations round differently, hence 1e-12)."""
     P = np.array([params(**over) for over in EDGES.values()])

@@ -1,5 +1,5 @@
 """gyro.roots: the roots of a batch of real polynomials with proven inclusion radii, in C
-(templates/polyroots.c.j2) and in NumPy, against roots known by construction and against
+(gyro/csrc/polyroots.c) and in NumPy, against roots known by construction and against
 each other; the cases that are not proven (a double root, a zero end coefficient) fall back
 to the companion's eigenvalues and say so."""
 from __future__ import annotations

@@ -1,22 +1,26 @@
-{# The null vectors and the contraction of the frequencies' sensitivities, in C
-   (gyro/analyses/sensitivity.py's NumPy paths): included by model.c.j2 after qep.c.j2 for a
-   model with an operator of dimension n. #}
-
 /* ---------------------------------------------------------------------------------------
  * Sensitivities of the roots: for each root lambda of a set, the right and left null
  * vectors of J(lambda) = M lambda^2 + D lambda + K by one step of inverse iteration from
  * one LU factorisation (partial pivoting), J x = b and J^H y = b from the same factors; then
  * y* dJ/dw x over the structural nonzeros of dJ/dw (w the parameters and the equilibrium
- * coordinates) and y* J'(lambda) x. Complex numbers are (re, im) interleaved.
+ * coordinates) and y* J'(lambda) x. Complex numbers are (re, im) interleaved. The NumPy
+ * paths of gyro/analyses/sensitivity.py are the reference the tests compare these with.
  * ------------------------------------------------------------------------------------- */
+#include <math.h>
+
+#include "kernels.h"
+
+#ifndef QEP_N
+#error "compile the sensitivity kernels with -DQEP_N=<the operator's dimension>"
+#endif
 
 /* LU with partial pivoting (largest |re| + |im| in the column, as LAPACK) of a complex
-   {{ n }} x {{ n }} J = (Jr, Ji), row-major, in place: P J = L U with L's multipliers below the
+   QEP_N x QEP_N J = (Jr, Ji), row-major, in place: P J = L U with L's multipliers below the
    diagonal and 1 / U's pivots on it; piv[k] the row swapped with row k at step k. 0 when a
    pivot is exactly zero (J singular in floating point), 1 otherwise. */
-static int {{ prefix }}_sens_lu(double *Jr, double *Ji, int *piv)
+static int sens_lu(double *Jr, double *Ji, int *piv)
 {
-    const int n = {{ n }};
+    const int n = QEP_N;
     for (int k = 0; k < n; ++k) {
         int p = k;
         double big = fabs(Jr[k * n + k]) + fabs(Ji[k * n + k]);
@@ -65,17 +69,17 @@ static int {{ prefix }}_sens_lu(double *Jr, double *Ji, int *piv)
 }
 
 /* v <- v / |v|_2 (scaled by its largest part first: no overflow of the squares) */
-static void {{ prefix }}_sens_unit(double *vr, double *vi)
+static void sens_unit(double *vr, double *vi)
 {
     double a = 0.0, s = 0.0;
-    for (int i = 0; i < {{ n }}; ++i)
+    for (int i = 0; i < QEP_N; ++i)
         a = fmax(a, fmax(fabs(vr[i]), fabs(vi[i])));
     if (!(a > 0.0) || !isfinite(a))
         return; /* zero or not finite: left as it is (NumPy's norm gives NaN there too) */
-    for (int i = 0; i < {{ n }}; ++i)
+    for (int i = 0; i < QEP_N; ++i)
         s += (vr[i] / a) * (vr[i] / a) + (vi[i] / a) * (vi[i] / a);
     const double f = 1.0 / (a * sqrt(s));
-    for (int i = 0; i < {{ n }}; ++i) {
+    for (int i = 0; i < QEP_N; ++i) {
         vr[i] *= f;
         vi[i] *= f;
     }
@@ -86,17 +90,17 @@ static void {{ prefix }}_sens_unit(double *vr, double *vi)
    hermitian (nsets) 1 where J is Hermitian at the set's roots (then y = x, no second
    solve). x, y (nsets, r, n) complex, unit; singular (nsets, r) 1 where a pivot of J is
    exactly zero (x and y are then left zero, for the caller's SVD). */
-void {{ prefix }}_sens_null_vectors_batch(long nsets, long r, const double *M, const double *D,
-                                          const double *K, const double *lam, const double *hermitian,
-                                          const double *rhs, double *x, double *y, double *singular)
+void gyro_sens_null_vectors_batch(long nsets, long r, const double *M, const double *D,
+                                  const double *K, const double *lam, const double *hermitian,
+                                  const double *rhs, double *x, double *y, double *singular)
 {
-    const int n = {{ n }};
+    const int n = QEP_N;
     for (long k = 0; k < nsets; ++k) {
         const double *Mk = M + k * n * n, *Dk = D + k * n * n, *Kk = K + k * n * n;
         for (long j = 0; j < r; ++j) {
             const long at = k * r + j;
-            double Jr[{{ n * n }}], Ji[{{ n * n }}], br[{{ n }}], bi[{{ n }}];
-            int piv[{{ n }}];
+            double Jr[QEP_N * QEP_N], Ji[QEP_N * QEP_N], br[QEP_N], bi[QEP_N];
+            int piv[QEP_N];
             const double lr = lam[2 * at] * (1 + 1e-15), li = lam[2 * at + 1] * (1 + 1e-15);
             const double l2r = lr * lr - li * li, l2i = 2.0 * lr * li;
             for (int e = 0; e < n * n; ++e) {
@@ -104,7 +108,7 @@ void {{ prefix }}_sens_null_vectors_batch(long nsets, long r, const double *M, c
                 Ji[e] = Mk[e] * l2i + Dk[e] * li;
             }
             double *xk = x + 2 * n * at, *yk = y + 2 * n * at;
-            if (!{{ prefix }}_sens_lu(Jr, Ji, piv)) {
+            if (!sens_lu(Jr, Ji, piv)) {
                 for (int i = 0; i < 2 * n; ++i)
                     xk[i] = yk[i] = 0.0;
                 singular[at] = 1.0;
@@ -135,7 +139,7 @@ void {{ prefix }}_sens_null_vectors_batch(long nsets, long r, const double *M, c
                 br[i] = sr * Jr[i * n + i] - si * Ji[i * n + i];
                 bi[i] = sr * Ji[i * n + i] + si * Jr[i * n + i];
             }
-            {{ prefix }}_sens_unit(br, bi);
+            sens_unit(br, bi);
             for (int i = 0; i < n; ++i) {
                 xk[2 * i] = br[i];
                 xk[2 * i + 1] = bi[i];
@@ -166,7 +170,7 @@ void {{ prefix }}_sens_null_vectors_batch(long nsets, long r, const double *M, c
                     double t = br[i]; br[i] = br[piv[i]]; br[piv[i]] = t;
                     t = bi[i]; bi[i] = bi[piv[i]]; bi[piv[i]] = t;
                 }
-            {{ prefix }}_sens_unit(br, bi);
+            sens_unit(br, bi);
             for (int i = 0; i < n; ++i) {
                 yk[2 * i] = br[i];
                 yk[2 * i + 1] = bi[i];
@@ -180,20 +184,20 @@ void {{ prefix }}_sens_null_vectors_batch(long nsets, long r, const double *M, c
    conj(y[row]) x[col] lambda^(2 - which) vals[k], the entry of M (which 0), D (1) or K (2)
    at rows[k] = which n^2 + row n + col, row-major, M then D then K; and den (nsets, r)
    complex, y* (2 M lambda + D) x. vals (nsets, nnz): the nonzeros' values per set. */
-void {{ prefix }}_sens_contract_batch(long nsets, long r, long nnz, long ncols, const long *rows,
-                                      const long *cols, const double *vals, const double *M,
-                                      const double *D, const double *lam, const double *x,
-                                      const double *y, double *h, double *den)
+void gyro_sens_contract_batch(long nsets, long r, long nnz, long ncols, const long *rows,
+                              const long *cols, const double *vals, const double *M,
+                              const double *D, const double *lam, const double *x,
+                              const double *y, double *h, double *den)
 {
-    const int n = {{ n }};
+    const int n = QEP_N;
     /* the roots in blocks of up to n, the root innermost: each nonzero's value is read once
        per block and added into every root's sum (a loop the compiler vectorises) */
-    double hr[ncols * {{ n }}], hi[ncols * {{ n }}];
+    double hr[ncols * QEP_N], hi[ncols * QEP_N];
     for (long k = 0; k < nsets; ++k) {
         const double *Mk = M + k * n * n, *Dk = D + k * n * n, *vk = vals + k * nnz;
         for (long j0 = 0; j0 < r; j0 += n) {
             const long nb = r - j0 < n ? r - j0 : n;
-            double wr[3][{{ n }}], wi[3][{{ n }}], gr[{{ n }}], gi[{{ n }}];
+            double wr[3][QEP_N], wi[3][QEP_N], gr[QEP_N], gi[QEP_N];
             for (long j = 0; j < nb; ++j) { /* the weights of M, D, K: lambda^2, lambda, 1 */
                 const double lr = lam[2 * (k * r + j0 + j)], li = lam[2 * (k * r + j0 + j) + 1];
                 wr[0][j] = lr * lr - li * li;

@@ -322,7 +322,20 @@ def linear_motion(red: ReducedState, z0: np.ndarray, t, corrections: int = 2, fi
     f(0)), each the linear system driven by the remainder (Duhamel's integral, r linear
     between the samples). `steps` is the fine grid's steps per sample interval (1 without a
     correction: the linear motion alone is exact on the sample grid). A grid of more than
-    FINE_BUDGET samples times states stops with IntegrationBudget, before any work."""
+    FINE_BUDGET samples times states stops with IntegrationBudget, before any work. Kept on
+    `red` for its later calls with the same arguments (a linear level, then an integrated
+    level's scale and the motion question's floor, on one motion: read-only arrays)."""
+    memo = red.__dict__.setdefault("_linear_motions", {})
+    key = (np.asarray(z0, float).tobytes(), np.asarray(t, float).tobytes(), corrections, fine)
+    if key not in memo:
+        memo.clear()  # the latest only
+        memo[key] = _linear_motion(red, z0, t, corrections, fine)
+        for a in memo[key][:2]:
+            a.flags.writeable = False
+    return memo[key]
+
+
+def _linear_motion(red: ReducedState, z0: np.ndarray, t, corrections: int, fine: int):
     t = uniform_times(t)
     A = red.first_order
     n2 = A.shape[0]
@@ -415,6 +428,13 @@ FINER = 1e-2  # the integrated level's second run's tolerance, of the first's
 FLOOR = 100.0  # the integrator's absolute tolerance, at least this many eps of the reference
 
 
+def integration_floor(size, rtol: float):
+    """The integrated level's smallest estimate (absolute) of a coordinate whose unit group's
+    largest magnitude is `size`: twice the finer run's tolerance on it. Known before the
+    runs from a prediction of the motion (gyro.questions.motion.floor)."""
+    return 2 * rtol * FINER * np.asarray(size, float)
+
+
 class _Generic:
     """The motion protocol of one model: INITIAL over its reduced coordinates (`<c>_0`, a
     displacement from the reference, `<c>_d0`, a rate offset, all 0 by default), Motion and
@@ -441,6 +461,8 @@ class _Generic:
             raise ParameterError(f"--set {bad[0]}: the initial condition must be a finite number")
         z0 = np.array([vals[f"{c}_0"] for c in self.reduced] + [vals[f"{c}_d0"] for c in self.reduced])
         return _Motion(self.model, dict(params), z0)
+
+    integration_floor = staticmethod(integration_floor)
 
     def motion_answer(self, motion, t, method: str = "linear", rtol: float = 1e-9, cap_of: str = CAP_OF[0]):
         """The reduced coordinates q_ref + x at the times t (times, n) and an estimate of each
@@ -497,7 +519,8 @@ def motion_answer(red: ReducedState, z0: np.ndarray, t, units: list, method: str
     zL = linear_motion(red, z0, t, CORRECTIONS, FINE)[0]
     scale = np.array([np.max(np.abs(zL[:, :n])), np.max(np.abs(zL[:, n:]))])
     q, est = ode.two_tolerances(lambda r: integrate_reduced(red, z0, t, method, r, scale, FLOOR), rtol, FINER)
-    return q, np.maximum(est, 2 * rtol * FINER * group_max(np.max(np.abs(q), axis=0), units))
+    return q, np.maximum(est, integration_floor(group_max(np.max(np.abs(q), axis=0), units), rtol))
+
 
 
 def for_model(model) -> _Generic:

@@ -595,3 +595,25 @@ def test_a_stopped_tolerance_leaves_no_temporary_folder(tmp_path, sig, code):
     out, err = p.communicate(timeout=60)
     assert p.returncode == code and out == "" and len(error_lines(err)) == 1, (p.returncode, err)
     assert not any(scratch.iterdir()), sorted(scratch.iterdir())
+
+
+def test_sundials_and_casadi_say_nothing_on_stderr(tmp_path):
+    """SUNDIALS' own lines (IDACalcIC's) and CasADi's warnings (a NaN of the right-hand side
+    at a horizon of 1e308) go to file descriptor 2, past Python's sys.stderr: in a process
+    of its own, every CasADi integrator's failure is the command's one line, nothing else."""
+    import subprocess
+    import sys
+
+    lines = [["simulate", "gimbal_gyroscope", "--method", "idas", "--t-end", "1e308", "--points", "5"],
+             ["simulate", "gimbal_gyroscope", "--method", "cvodes", "--t-end", "1e308", "--points", "5"],
+             ["simulate", "gyrohorizoncompass", "--method", "cvodes-adams", "--t-end", "1e308", "--points", "5"]]
+    driver = ("import os, sys\nfrom gyro.cli import main\n"
+              f"for argv in {lines!r}:\n"
+              "    code = main(argv)\n    sys.stderr.flush()\n    os.write(2, f'exit {code}\\n'.encode())\n")
+    p = subprocess.run([sys.executable, "-c", driver], capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert p.returncode == 0 and p.stdout == "", p.stderr
+    said = [ln for ln in p.stderr.splitlines() if not ln.startswith("gyro: compiling the generated C")]
+    for k, argv in enumerate(lines):
+        line, code = said[2 * k: 2 * k + 2]
+        assert line.startswith("gyro: error: numerical failure") and argv[3] in line and code == "exit 1", said
+    assert len(said) == 2 * len(lines), said

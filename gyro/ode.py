@@ -253,8 +253,7 @@ class watching:
         if self.progress:
             from tqdm import tqdm
 
-            bar = tqdm(total=100, desc=f"{self.label} (integration {run})", unit="%", leave=False,
-                       file=sys.stderr, bar_format="{desc}: {percentage:3.0f}% [{elapsed}<{remaining}]")
+            bar = tqdm(total=100, desc=f"{self.label} (integration {run})", unit="%", leave=False, file=sys.stderr)
         start, calls, span = time.perf_counter(), [0], (t1 - t0) or 1.0
 
         def rhs(tt, y):
@@ -262,9 +261,8 @@ class watching:
             if calls[0] % self.EVERY == 0:
                 frac = min(max((tt - t0) / span, 0.0), 1.0)
                 took = time.perf_counter() - start
-                if bar is not None:
-                    bar.n = int(100 * frac)
-                    bar.refresh()
+                if bar is not None and int(100 * frac) > bar.n:
+                    bar.update(int(100 * frac) - bar.n)  # drawn at tqdm's own pace
                 if self.budget is not None and took >= self.PILOT and frac > 0:
                     predicted = self.spent + took / frac * (1 + after)
                     if predicted > self.budget:

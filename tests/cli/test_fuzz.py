@@ -606,7 +606,12 @@ def test_sundials_and_casadi_say_nothing_on_stderr(tmp_path):
 
     lines = [["simulate", "gimbal_gyroscope", "--method", "idas", "--t-end", "1e308", "--points", "5"],
              ["simulate", "gimbal_gyroscope", "--method", "cvodes", "--t-end", "1e308", "--points", "5"],
-             ["simulate", "gyrohorizoncompass", "--method", "cvodes-adams", "--t-end", "1e308", "--points", "5"]]
+             ["simulate", "gyrohorizoncompass", "--method", "cvodes-adams", "--t-end", "1e308", "--points", "5"],
+             # a precession level's own CVODES near +-90 deg (newer_lines under SEED 22, its line 257):
+             # 316814 lines of CasADi's NaN warnings and 54 s before, one line in 7 s now
+             ["simulate", "gimbal_precession", "--level", "small", "--t-end", "0.2", "--points", "2", "--set",
+              "f_phi=1"]]
+    says = ["idas stopped", "cvodes stopped", "cvodes-adams stopped", "small: the integration stopped near"]
     driver = ("import os, sys\nfrom gyro.cli import main\n"
               f"for argv in {lines!r}:\n"
               "    code = main(argv)\n    sys.stderr.flush()\n    os.write(2, f'exit {code}\\n'.encode())\n")
@@ -615,5 +620,5 @@ def test_sundials_and_casadi_say_nothing_on_stderr(tmp_path):
     said = [ln for ln in p.stderr.splitlines() if not ln.startswith("gyro: compiling the generated C")]
     for k, argv in enumerate(lines):
         line, code = said[2 * k: 2 * k + 2]
-        assert line.startswith("gyro: error: numerical failure") and argv[3] in line and code == "exit 1", said
+        assert line.startswith("gyro: error: ") and says[k] in line and code in ("exit 1", "exit 2"), said
     assert len(said) == 2 * len(lines), said

@@ -201,9 +201,8 @@ class OverBudget(IntegrationBudget):
     """A watched block of integrations (`watching`) whose predicted cost is over its budget,
     raised after its pilot: `seconds` the prediction, `measured` what it was measured on."""
 
-    def __init__(self, seconds: float, measured: float, run: int, budget: float):
-        self.seconds, self.budget = seconds, budget
-        self.measured = f"measured on {100 * measured:.2g}% of integration {run}"
+    def __init__(self, seconds: float, measured: str, budget: float):
+        self.seconds, self.budget, self.measured = seconds, budget, measured
         super().__init__(f"about {seconds:.0f} s predicted ({self.measured}), over the budget of {budget:.0f} s")
 
 
@@ -236,6 +235,12 @@ class watching:
         WATCH = self.saved
         return False
 
+    def check(self, seconds: float, measured: str) -> None:
+        """OverBudget where work predicted to take `seconds` (`measured`: on what) would
+        take the block over its budget; the work is counted as spent once checked."""
+        if self.budget is not None and self.spent + seconds > self.budget:
+            raise OverBudget(self.spent + seconds, measured, self.budget)
+
     def plan(self, weights) -> None:
         """The runs to come, each one's cost relative to the first of them."""
         self.later = list(weights)
@@ -267,7 +272,7 @@ class watching:
                     predicted = self.spent + took / frac * (1 + after)
                     if predicted > self.budget:
                         self._close(bar)
-                        raise OverBudget(predicted, frac, run, self.budget)
+                        raise OverBudget(predicted, f"measured on {100 * frac:.2g}% of integration {run}", self.budget)
             return fun(tt, y)
 
         def done():

@@ -173,6 +173,9 @@ def floor(model, level, P, opts) -> np.ndarray:
     Measured on the torsion gyrocompass's DOP853 level at rtol 1e-9 over 1 s: 1.41e-11
     (its bound found there is 2.08e-8, the two runs' difference); `--tol 1e-13` is refused
     without integrating (it integrated for 38 s before)."""
+    from gyro import ode
+    from gyro.errors import ParameterError
+
     out = np.zeros(P.shape[0])
     mod = _analysis(level, model)
     if level.evaluator.get("method") == "linear" or not hasattr(mod, "integration_floor"):
@@ -180,7 +183,10 @@ def floor(model, level, P, opts) -> np.ndarray:
     t, kind, rtol = times(opts), _declared(model)["scale"], level.evaluator.get("rtol", 1e-10)
     for k, motion in _motions(mod, model, level, P, _initial(mod, opts)):
         try:  # the linear level's answer (its work kept on the motion where it ran before)
-            qL, d = mod.motion_answer(motion(), t, "linear")
+            with _watched(level):
+                qL, d = mod.motion_answer(motion(), t, "linear")
+        except ode.OverBudget as exc:
+            raise ParameterError(_over_budget(model, P[k], _initial(mod, opts), t[-1], level.name, exc, opts)) from None
         except (ArithmeticError, ValueError, RuntimeError):
             continue
         if not (np.all(np.isfinite(qL)) and np.all(np.isfinite(d))):
@@ -196,8 +202,18 @@ def floor(model, level, P, opts) -> np.ndarray:
     return out
 
 
-def answer(model, level, P, opts) -> Answer:
+def _watched(level):
+    """A level's long work shows how far it is on a terminal, and is held to the command
+    line's budget by its cost predicted as it goes (gyro.ode.watching)."""
+    import sys
+
     from gyro import executor, ode
+
+    return ode.watching(level.name, executor.BUDGET, sys.stderr.isatty())
+
+
+def answer(model, level, P, opts) -> Answer:
+    from gyro import ode
     from gyro.errors import ParameterError
 
     if level.evaluator.get("kind") != "trajectory":
@@ -212,13 +228,9 @@ def answer(model, level, P, opts) -> Answer:
     scales = np.full((N, nc), np.nan)
     failed = np.full(N, "", object)
     extra = {k: level.evaluator[k] for k in PASSED if k in level.evaluator}
-    import sys
-
     for k, motion in _motions(mod, model, level, P, init):
         try:
-            # a long integration shows how far it is on a terminal, and is held to the command
-            # line's budget by its cost predicted as it goes (ode.watching)
-            with ode.watching(level.name, executor.BUDGET, sys.stderr.isatty()):
+            with _watched(level):
                 q, e = mod.motion_answer(motion(), t, level.evaluator["method"], level.evaluator.get("rtol", 1e-10),
                                          **extra)
         except ode.OverBudget as exc:  # the request's, not the set's: raised past the next clause
@@ -241,7 +253,7 @@ def _over_budget(model, p, init: dict, horizon: float, level: str, exc, opts) ->
     extra = initial_conditions(model)
     w = _fastest(model, p[None, :], {n: float(np.ravel(v)[0]) for n, v in init.items() if n in extra}, extra)
     given = "" if "horizon" in opts else " (the default)"
-    return (f"--horizon {horizon:g}{given}: {level} integrates {horizon * w / (2 * np.pi):.3g} periods of the "
+    return (f"--horizon {horizon:g}{given}: {level} follows {horizon * w / (2 * np.pi):.3g} periods of the "
             f"fastest motion ({w:.4g} rad/s), about {exc.seconds:.0f} s in this process ({exc.measured}), "
             f"over the command line's budget of {exc.budget:.0f} s: a shorter --horizon, or a larger --tol")
 

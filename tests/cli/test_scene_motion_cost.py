@@ -9,6 +9,7 @@ import contextlib
 import io
 
 import numpy as np
+import pytest
 
 from gyro import levels as hierarchy
 from gyro import ode
@@ -42,18 +43,35 @@ def test_the_floor_is_below_the_integrated_bound_and_refuses_before_the_run():
     assert scene.best(0) == (floor[0], "nonlinear_motion")
 
 
-def test_an_integration_over_the_budget_is_refused_in_one_line(monkeypatch):
-    """The linear level cannot answer a 0.2 rad tilt at 1e-3, so the integrated level runs;
-    with a budget of a nanosecond its predicted cost is over it at the first look."""
+def test_a_motion_over_the_budget_is_refused_in_one_line(monkeypatch):
+    """With a budget of a nanosecond, the linear level's corrections are over it once their
+    remainder is timed on a few samples: one line naming --horizon and the cost, exit 2."""
     import gyro.cli
 
     monkeypatch.setattr(gyro.cli, "COMMAND_BUDGET", 1e-9)
-    monkeypatch.setattr(ode.watching, "PILOT", 0.0)
-    rc, out, err = run_cli("scene", TG, "motion", "--tol", "1e-3", "--horizon", "0.01", "--set", "gamma1_0=0",
-                           "--set", "gamma_0=0.2")
+    monkeypatch.setattr(Q, "_MOTIONS", {})  # no linear motion of this set kept by an earlier test
+    rc, out, err = run_cli("scene", TG, "motion", "--tol", "1e-3", "--horizon", "0.01")
     assert rc == 2 and out == "" and len(error_lines(err)) == 1, (rc, err)
-    assert "--horizon 0.01: nonlinear_motion integrates" in err and "periods of the fastest motion" in err
-    assert "budget" in err and "(the default)" not in err
+    assert "--horizon 0.01: linear_motion follows" in err and "periods of the fastest motion" in err
+    assert "remainder timed on" in err and "budget of 0 s" in err and "(the default)" not in err
+
+
+def test_an_integration_over_the_budget_stops_after_its_pilot(monkeypatch):
+    """The integrated level (its scale's linear motion already made by the linear level)
+    stops at the first look at the clock once its pilot is over: the time so far carried
+    to the horizon's end is over a nanosecond on any machine."""
+    from gyro import executor
+    from gyro.errors import ParameterError
+
+    tg = load(TG)
+    P = tg.vector()[None, :]
+    opts = dict(OPTS, initial={"gamma1_0": 0.0, "gamma_0": 0.2})
+    monkeypatch.setattr(Q, "_MOTIONS", {})
+    assert Q.answer(tg, hierarchy.get(tg, "linear_motion"), P, opts).failed[0] == ""
+    monkeypatch.setattr(ode.watching, "PILOT", 0.0)
+    with executor.budget(1e-9), pytest.raises(ParameterError, match="nonlinear_motion follows") as got:
+        Q.answer(tg, hierarchy.get(tg, "nonlinear_motion"), P, opts)
+    assert "of integration 1" in str(got.value) and "--horizon 0.01:" in str(got.value)
 
 
 def test_a_watched_integration_shows_its_progress():

@@ -210,20 +210,21 @@ WATCH = None  # the `watching` block the integrations run in now, or None
 
 
 class watching:
-    """`with watching(label, budget, progress):` every SciPy integration inside (integrate_state)
-    shows how far it is in t (a tqdm bar on stderr where `progress`), and the block is held
-    to `budget` seconds (None: none): once a run has taken PILOT seconds, its time so far
-    carried to the end of its horizon, plus the runs before it and the runs still planned
-    (`plan`: their costs relative to this one's, two_tolerances declares its second), is the
-    block's predicted cost, checked as it goes; over the budget the run stops there
-    (OverBudget), a few seconds in rather than at the end."""
+    """`with watching(label, budget, progress, spent):` every SciPy integration inside
+    (integrate_state), and any long work that meters itself (`meter`: the linear motion's
+    corrections), shows how far it is (a tqdm bar on stderr where `progress`), and the block
+    is held to `budget` seconds (None: none) with `spent` already gone: once a piece has
+    taken PILOT seconds, its time so far carried to its end, plus the pieces before it and
+    those still planned (`plan`: their costs relative to this one's, two_tolerances declares
+    its second run), is the predicted cost, checked as it goes; over the budget the piece
+    stops there (OverBudget), a few seconds in rather than at the end."""
 
     PILOT = 1.0  # s of a run before its prediction is trusted
     EVERY = 100  # evaluations of the right-hand side between two looks at the clock
 
-    def __init__(self, label: str, budget: float | None = None, progress: bool = False):
+    def __init__(self, label: str, budget: float | None = None, progress: bool = False, spent: float = 0.0):
         self.label, self.budget, self.progress = label, budget, progress
-        self.spent, self.later, self.runs = 0.0, [], 0
+        self.spent, self.later, self.runs = spent, [], 0  # spent: the command's time before the block
 
     def __enter__(self):
         global WATCH
@@ -235,57 +236,63 @@ class watching:
         WATCH = self.saved
         return False
 
-    def check(self, seconds: float, measured: str) -> None:
-        """OverBudget where work predicted to take `seconds` (`measured`: on what) would
-        take the block over its budget; the work is counted as spent once checked."""
-        if self.budget is not None and self.spent + seconds > self.budget:
-            raise OverBudget(self.spent + seconds, measured, self.budget)
-
     def plan(self, weights) -> None:
-        """The runs to come, each one's cost relative to the first of them."""
+        """The pieces of work to come, each one's cost relative to the first of them."""
         self.later = list(weights)
 
-    def wrap(self, fun, t0: float, t1: float):
-        """fun(t, y) for solve_ivp, watched over [t0, t1]; call done() after the run."""
+    def meter(self, what: str):
+        """(tick(fraction done), done()) of one piece of work, `what`: its bar, and, once it
+        has taken PILOT seconds, its time carried to its end and to the planned pieces after
+        it, plus what the block spent before, against the budget (OverBudget)."""
         import sys
         import time
 
         weight = self.later.pop(0) if self.later else 1.0
-        after = sum(self.later) / weight  # the planned runs after this one, in units of this one
-        self.runs += 1
-        run = self.runs
+        after = sum(self.later) / weight  # the planned pieces after this one, in units of this one
         bar = None
         if self.progress:
             from tqdm import tqdm
 
-            bar = tqdm(total=100, desc=f"{self.label} (integration {run})", unit="%", leave=False, file=sys.stderr)
-        start, calls, span = time.perf_counter(), [0], (t1 - t0) or 1.0
+            bar = tqdm(total=100, desc=f"{self.label} ({what})", unit="%", leave=False, file=sys.stderr)
+        start = time.perf_counter()
+
+        def tick(frac: float) -> None:
+            frac = min(max(frac, 0.0), 1.0)
+            took = time.perf_counter() - start
+            if bar is not None and int(100 * frac) > bar.n:
+                bar.update(int(100 * frac) - bar.n)  # drawn at tqdm's own pace
+            if self.budget is not None and took >= self.PILOT and frac > 0:
+                predicted = self.spent + took / frac * (1 + after)
+                if predicted > self.budget:
+                    done()
+                    raise OverBudget(predicted, f"measured on {100 * frac:.2g}% of {what}", self.budget)
+
+        def done() -> None:
+            nonlocal bar
+            if bar is not None:
+                bar.close()
+                bar = None
+
+        def finished() -> None:
+            self.spent += time.perf_counter() - start
+            done()
+
+        return tick, finished
+
+    def wrap(self, fun, t0: float, t1: float):
+        """fun(t, y) for solve_ivp, watched over [t0, t1]; call its done() after the run."""
+        self.runs += 1
+        tick, finished = self.meter(f"integration {self.runs}")
+        calls, span = [0], (t1 - t0) or 1.0
 
         def rhs(tt, y):
             calls[0] += 1
             if calls[0] % self.EVERY == 0:
-                frac = min(max((tt - t0) / span, 0.0), 1.0)
-                took = time.perf_counter() - start
-                if bar is not None and int(100 * frac) > bar.n:
-                    bar.update(int(100 * frac) - bar.n)  # drawn at tqdm's own pace
-                if self.budget is not None and took >= self.PILOT and frac > 0:
-                    predicted = self.spent + took / frac * (1 + after)
-                    if predicted > self.budget:
-                        self._close(bar)
-                        raise OverBudget(predicted, f"measured on {100 * frac:.2g}% of integration {run}", self.budget)
+                tick((tt - t0) / span)
             return fun(tt, y)
 
-        def done():
-            self.spent += time.perf_counter() - start
-            self._close(bar)
-
-        rhs.done = done
+        rhs.done = finished
         return rhs
-
-    @staticmethod
-    def _close(bar) -> None:
-        if bar is not None:
-            bar.close()
 
 
 def two_tolerances(run, rtol: float, finer: float = 1e-2):

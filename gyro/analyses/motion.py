@@ -350,32 +350,40 @@ def _linear_motion(red: ReducedState, z0: np.ndarray, t, corrections: int, fine:
     tf = np.linspace(0.0, t[-1], (t.size - 1) * per + 1)
     Ad, B0, B1 = first_order_hold(A, tf[1] - tf[0])
     zL = propagate(Ad, np.zeros((tf.size - 1, n2)), np.asarray(z0, float))
-    f = red.rhs.map(tf.size)
+    f = red.rhs.map(tf.size) if ode.WATCH is None or tf.size <= CHUNK else None
     e = np.zeros_like(zL)
-    if corrections and ode.WATCH is not None and ode.WATCH.budget is not None:
-        _pilot(red, zL, A, corrections)
-    for _ in range(corrections):
+    if f is None:  # metered: the corrections cost alike
+        ode.WATCH.plan([1.0] * corrections)
+    for c in range(corrections):
         z = zL + e
-        r = np.asarray(f(z.T)).T - z @ A.T
+        r = _remainder(red, z, f, f"the linear motion's correction {c + 1} of {corrections}") - z @ A.T
         e = propagate(Ad, r[:-1] @ B0 + r[1:] @ B1, np.zeros(n2))
     return zL[::per], e[::per], per
 
 
-PILOT = 2000  # samples of the remainder timed, where a budget watches (ode.watching)
+CHUNK = 10_000  # samples of the remainder evaluated at a time where a watch meters it (ode.watching)
 
 
-def _pilot(red: ReducedState, zL: np.ndarray, A: np.ndarray, corrections: int) -> None:
-    """The corrections' cost predicted from PILOT samples of the remainder (its evaluation is
-    most of it: 7.6 of 9.8 s on the torsion gyrocompass over 1 s, 39000 samples) and held to
-    the watching block's budget before they run (OverBudget)."""
-    import time
-
-    k = min(PILOT, zL.shape[0])
-    start = time.perf_counter()
-    red.rhs.map(k)(zL[:k].T)
-    each = (time.perf_counter() - start) / k
-    ode.WATCH.check(each * zL.shape[0] * corrections * 1.3,  # 1.3: the propagation, measured 0.9 of 7.6 s
-                    f"the linear motion's remainder timed on {k} of its {zL.shape[0]} samples")
+def _remainder(red: ReducedState, z: np.ndarray, f, what: str) -> np.ndarray:
+    """f(z) over the samples z (rows): at once, or where a watch is on (ode.watching: the
+    command line's budget, a terminal's bar) in CHUNKs, metered as `what`; its evaluation
+    is most of the linear motion's work (7.6 of 9.8 s on the torsion gyrocompass over 1 s,
+    39000 samples)."""
+    watch = ode.WATCH
+    if watch is None or z.shape[0] <= CHUNK:
+        return np.asarray(f(z.T)).T
+    tick, finished = watch.meter(what)
+    out = np.empty_like(z)
+    each = red.rhs.map(CHUNK)
+    try:
+        for s in range(0, z.shape[0], CHUNK):
+            block = z[s:s + CHUNK]
+            g = each if block.shape[0] == CHUNK else red.rhs.map(block.shape[0])
+            out[s:s + CHUNK] = np.asarray(g(block.T)).T
+            tick((s + block.shape[0]) / z.shape[0])
+    finally:
+        finished()
+    return out
 
 
 def integrate_reduced(red: ReducedState, z0: np.ndarray, t, method: str = "DOP853", rtol: float = 1e-9,

@@ -206,10 +206,12 @@ def _watched(level):
     """A level's long work shows how far it is on a terminal, and is held to the command
     line's budget by its cost predicted as it goes (gyro.ode.watching)."""
     import sys
+    import time
 
     from gyro import executor, ode
 
-    return ode.watching(level.name, executor.BUDGET, sys.stderr.isatty())
+    spent = time.perf_counter() - executor.STARTED if executor.BUDGET is not None else 0.0
+    return ode.watching(level.name, executor.BUDGET, sys.stderr.isatty(), spent)
 
 
 def answer(model, level, P, opts) -> Answer:

@@ -44,16 +44,19 @@ def test_the_floor_is_below_the_integrated_bound_and_refuses_before_the_run():
 
 
 def test_a_motion_over_the_budget_is_refused_in_one_line(monkeypatch):
-    """With a budget of a nanosecond, the linear level's corrections are over it once their
-    remainder is timed on a few samples: one line naming --horizon and the cost, exit 2."""
+    """With a budget of a nanosecond, the linear level's corrections (metered in chunks of
+    100 samples here) are over it after their first chunk: one line naming --horizon and
+    the cost, exit 2."""
     import gyro.cli
 
     monkeypatch.setattr(gyro.cli, "COMMAND_BUDGET", 1e-9)
+    monkeypatch.setattr(generic, "CHUNK", 100)
+    monkeypatch.setattr(ode.watching, "PILOT", 0.0)
     monkeypatch.setattr(Q, "_MOTIONS", {})  # no linear motion of this set kept by an earlier test
     rc, out, err = run_cli("scene", TG, "motion", "--tol", "1e-3", "--horizon", "0.01")
     assert rc == 2 and out == "" and len(error_lines(err)) == 1, (rc, err)
     assert "--horizon 0.01: linear_motion follows" in err and "periods of the fastest motion" in err
-    assert "remainder timed on" in err and "budget of 0 s" in err and "(the default)" not in err
+    assert "of the linear motion's correction 1 of 2" in err and "budget of 0 s" in err and "(the default)" not in err
 
 
 def test_an_integration_over_the_budget_stops_after_its_pilot(monkeypatch):

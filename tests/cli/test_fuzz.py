@@ -20,7 +20,10 @@ from gyro.models import load
 from tests.conftest import error_lines
 
 N_LINES = 1400
-SEED = 20261130
+# another seed, and more lines of the fuzz of every command, for a run by hand (docs/fuzz.md):
+# GYRO_FUZZ_SEED=11 GYRO_FUZZ_LINES=500 pytest tests/cli/test_fuzz.py -k seeded -p no:xdist
+SEED = int(__import__("os").environ.get("GYRO_FUZZ_SEED", 20261130))
+EVERY_LINES = int(__import__("os").environ.get("GYRO_FUZZ_LINES", 100))
 WEIRD = ["nan", "inf", "-inf", "0", "-0", "-1", "1e-300", "1e300", "1e-12", "1e12", "abc", "", "1,5",
          "9223372036854775808", "3", "0.5", "-1e300"]
 
@@ -523,7 +526,7 @@ def test_every_command_under_a_seeded_fuzz(tmp_path, scratch, short_budgets):
     outs.mkdir()
     _junk_model(outs)
     codes = []
-    for argv in every_command_lines(outs, 100):
+    for argv in every_command_lines(outs, EVERY_LINES):
         code, out, err, dt = run(argv)
         _holds(argv, code, out, err, dt, outs, scratch)
         codes.append((argv[0], code))

@@ -158,6 +158,7 @@ def _motions(mod, model, level, P, init):
                     del _MOTIONS[next(iter(_MOTIONS))]
             return _MOTIONS[key]
 
+        made.initial = ic
         yield k, made
 
 
@@ -186,7 +187,7 @@ def floor(model, level, P, opts) -> np.ndarray:
             with _watched(level):
                 qL, d = mod.motion_answer(motion(), t, "linear")
         except ode.OverBudget as exc:
-            raise ParameterError(_over_budget(model, P[k], _initial(mod, opts), t[-1], level.name, exc, opts)) from None
+            raise ParameterError(_over_budget(model, P[k], motion.initial, t[-1], level.name, exc, opts)) from None
         except (ArithmeticError, ValueError, RuntimeError):
             continue
         if not (np.all(np.isfinite(qL)) and np.all(np.isfinite(d))):
@@ -236,7 +237,7 @@ def answer(model, level, P, opts) -> Answer:
                 q, e = mod.motion_answer(motion(), t, level.evaluator["method"], level.evaluator.get("rtol", 1e-10),
                                          **extra)
         except ode.OverBudget as exc:  # the request's, not the set's: raised past the next clause
-            raise ParameterError(_over_budget(model, P[k], init, t[-1], level.name, exc, opts)) from None
+            raise ParameterError(_over_budget(model, P[k], motion.initial, t[-1], level.name, exc, opts)) from None
         except (ArithmeticError, ValueError, RuntimeError) as exc:  # a refusal or a failure: its reason
             failed[k] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             continue
@@ -251,9 +252,10 @@ def answer(model, level, P, opts) -> Answer:
 
 
 def _over_budget(model, p, init: dict, horizon: float, level: str, exc, opts) -> str:
-    """The one line of a motion whose integrations are over the command line's budget."""
+    """The one line of a motion whose work is over the command line's budget (`init`: the
+    set's initial conditions)."""
     extra = initial_conditions(model)
-    w = _fastest(model, p[None, :], {n: float(np.ravel(v)[0]) for n, v in init.items() if n in extra}, extra)
+    w = _fastest(model, p[None, :], {n: v for n, v in init.items() if n in extra}, extra)
     given = "" if "horizon" in opts else " (the default)"
     return (f"--horizon {horizon:g}{given}: {level} follows {horizon * w / (2 * np.pi):.3g} periods of the "
             f"fastest motion ({w:.4g} rad/s), about {exc.seconds:.0f} s in this process ({exc.measured}), "

@@ -168,11 +168,16 @@ def main(argv=None) -> int:
     ap.add_argument("--model", metavar="PATH.py", action="append", default=[],
                     help="a model file (or folder) anywhere; may be repeated")
     ap.add_argument("--out", default="generated", help="output folder (default: generated)")
+    ap.add_argument("--input-hash", metavar="PATH.py", dest="input_hash",
+                    help="print the hash of what a derivation of this model file (or folder) reads, as a "
+                         "generated package's metadata.json carries it (generated.input_hash), and stop")
     ap.add_argument("--jobs", type=int, default=1, metavar="N",
                     help="cores to use (Linux): up to N models side by side, each sharing the emission "
                          "of its functions among up to N workers of its own (default 1; this machine "
                          f"has {parallel.usable_cores()})")
     args = ap.parse_args(argv)
+    if args.input_hash is not None:
+        return _input_hash(Path(args.input_hash))
     if args.jobs < 1:
         print(f"derive: --jobs must be at least 1, got {args.jobs}", file=sys.stderr)
         return 2
@@ -181,6 +186,19 @@ def main(argv=None) -> int:
         return _main(args)
     finally:
         parallel.JOBS = before  # called in a process that goes on (a session, a test)
+
+
+def _input_hash(path: Path) -> int:
+    """The emitter's input hash of a model file, read without importing it: what the runtime
+    compares with a generated package's before deriving a file that may be its source."""
+    path = path.resolve()
+    if path.is_dir():
+        path = path / "__init__.py"
+    if not path.is_file():
+        print(f"derive: {path}: no such model file", file=sys.stderr)
+        return 2
+    print(emit.input_hash(path))
+    return 0
 
 
 def _main(args) -> int:

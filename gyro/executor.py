@@ -27,6 +27,8 @@ import numpy as np
 
 SERIAL = None  # the in-process executor
 BUDGET: float | None = None  # seconds a run in this process may take (the command line sets it: budget())
+STARTED = 0.0  # time.perf_counter() when the budget was set: a command's work predicted as it goes
+# counts what it spent before (gyro.ode.watching)
 
 
 class budget:
@@ -40,13 +42,14 @@ class budget:
         self.seconds = seconds
 
     def __enter__(self):
-        global BUDGET
-        self.saved, BUDGET = BUDGET, self.seconds
+        global BUDGET, STARTED
+        self.saved, BUDGET = (BUDGET, STARTED), self.seconds
+        STARTED = time.perf_counter()
         return self
 
     def __exit__(self, *exc):
-        global BUDGET
-        BUDGET = self.saved
+        global BUDGET, STARTED
+        BUDGET, STARTED = self.saved
         return False
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gyro.catalog import GENERATED_PACKAGE, available, generated_dir  # noqa: F401
+from gyro.catalog import GENERATED_PACKAGE, available, generated_dir, metadata  # noqa: F401
 from gyro.errors import ParameterError
 
 GENERATED = generated_dir()
@@ -234,7 +234,9 @@ def load(name: str | Path) -> Model:
     model_name = directory.name
     known = _CACHE.get(model_name)
     if known is None or known.directory != directory:
-        _CACHE[model_name] = Model(model_name, directory)
+        # a model file whose derivation is a generated package (derived_folder): that model
+        builtin = kind == "file" and directory == GENERATED / model_name
+        _CACHE[model_name] = Model(model_name) if builtin else Model(model_name, directory)
     return _CACHE[model_name]
 
 
@@ -248,7 +250,7 @@ def _source_root() -> Path | None:
 def model_key(path: Path, root: Path) -> str:
     """The hash of everything a derivation of the model file `path` reads: the file (or the
     model folder's Python files) and the Python files beside it (a model file may import
-    them), the machinery (derive/, templates/) and the versions of SymPy and SymEngine."""
+    them), the machinery (derive/, templates/) and the versions of the symbolic tools."""
     import hashlib
     from importlib.metadata import PackageNotFoundError, version
 
@@ -265,7 +267,7 @@ def model_key(path: Path, root: Path) -> str:
             continue
         h.update(str(p.relative_to(root) if p.is_relative_to(root) else p).encode() + b"\0")
         h.update(data + b"\0")
-    for dist in ("sympy", "symengine"):
+    for dist in ("sympy", "symengine", "casadi", "jinja2"):  # derive.emit's TOOL_VERSIONS
         try:
             h.update(f"{dist}={version(dist)}".encode())
         except PackageNotFoundError:
@@ -302,12 +304,15 @@ def derived_folder(path: Path) -> Path:
     failed = home / f"{done.name}.failed"  # a file the machinery refused: the same inputs, the same line
     if failed.is_file():
         raise ParameterError(failed.read_text().strip())
+    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1",  # no __pycache__ beside the user's file
+               PYTHONPATH=os.pathsep.join([str(root)] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
+    twin = generated_twin(path, root, home / f"{done.name}.generated", env)
+    if twin is not None:
+        return GENERATED / twin
     home.mkdir(parents=True, exist_ok=True)
     tmp = home / f"{done.name}.tmp-{os.getpid()}"
     shutil.rmtree(tmp, ignore_errors=True)
     notice = _Notice(f"gyro: deriving {_stem(path)} from {path} (first use, {_why(path, root)}cached after in {done})")
-    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1",  # no __pycache__ beside the user's file
-               PYTHONPATH=os.pathsep.join([str(root)] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
     try:
         proc = subprocess.run([sys.executable, "-m", "derive", "--model", str(path.resolve()), "--out", str(tmp)],
                               cwd=root, env=env, capture_output=True, text=True)
@@ -341,16 +346,59 @@ def derived_folder(path: Path) -> Path:
     return done / made[0].name
 
 
+def generated_twin(path: Path, root: Path, marker: Path, env: dict) -> str | None:
+    """The generated model whose package a derivation of the model file `path` would give,
+    or None: the one whose metadata's input hash (derive.emit.input_hash: the machinery,
+    the templates, the model's own file(s) by their names, the tool versions) equals this
+    file's. Same inputs, same bytes (make check-generated), so that package is the answer
+    and nothing is derived: a generated model's own source file, or a byte-identical copy
+    of it under the same name elsewhere; a file that differs by one byte derives its own.
+    The hash is computed by `python -m derive --input-hash` (about a second, the runtime
+    imports no derive/) only where a generated model's source has this file's name, and
+    is kept in `marker` (under the runtime's own key of the file), checked again against
+    the generated package at each use: a package derived again since is not taken."""
+    import os
+    import subprocess
+    import sys
+
+    own = path.resolve() / "__init__.py" if path.is_dir() else path.resolve()
+    hashes = {n: metadata(n).get("generated", {}) for n in available()}
+    hashes = {n: g["input_hash"] for n, g in hashes.items()
+              if isinstance(g, dict) and Path(str(g.get("source", ""))).name == own.name and g.get("input_hash")}
+    if not hashes:
+        return None
+    try:
+        name, digest = marker.read_text().split()
+        if hashes.get(name) == digest:
+            return name
+    except (OSError, ValueError):
+        pass
+    proc = subprocess.run([sys.executable, "-m", "derive", "--input-hash", str(own)],
+                          cwd=root, env=env, capture_output=True, text=True)
+    digest = proc.stdout.strip() if proc.returncode == 0 else None
+    name = next((n for n, h in hashes.items() if h == digest), None)
+    if name is not None:
+        try:  # written whole or not at all
+            marker.parent.mkdir(parents=True, exist_ok=True)
+            part = marker.with_name(f"{marker.name}.tmp-{os.getpid()}")
+            part.write_text(f"{name} {digest}\n")
+            os.replace(part, marker)
+        except OSError:
+            pass
+    return name
+
+
 def _stem(path: Path) -> str:
     return path.resolve().parent.name if path.is_dir() or path.name == "__init__.py" else path.stem
 
 
 def _why(path: Path, root: Path) -> str:
-    """What a first derivation of `path` is, when it is a generated model's own source file."""
+    """What a first derivation of `path` is, when it is a generated model's own source file
+    (and derives nevertheless: generated/ is not this file's derivation, generated_twin)."""
     own = root / "derive" / "models" / f"{_stem(path)}.py"
     if path.resolve() == own.resolve() and _stem(path) in available():
-        return (f"about a minute: the generated model {_stem(path)!r} is this file already derived, "
-                "give its name to skip this; ")
+        return (f"about a minute: generated/{_stem(path)} was derived from other inputs (`make derive` "
+                "brings it up to date); ")
     return ""
 
 

@@ -197,6 +197,104 @@ def budgeted(fun, label: str, t_end: float, max_s: float, max_steps: float, erro
     return rhs
 
 
+class OverBudget(IntegrationBudget):
+    """A watched block of integrations (`watching`) whose predicted cost is over its budget,
+    raised after its pilot: `seconds` the prediction, `measured` what it was measured on."""
+
+    def __init__(self, seconds: float, measured: str, budget: float):
+        self.seconds, self.budget, self.measured = seconds, budget, measured
+        super().__init__(f"about {seconds:.0f} s predicted ({self.measured}), over the budget of {budget:.0f} s")
+
+
+WATCH = None  # the `watching` block the integrations run in now, or None
+
+
+class watching:
+    """`with watching(label, budget, progress, spent):` every SciPy integration inside
+    (integrate_state), and any long work that meters itself (`meter`: the linear motion's
+    corrections), shows how far it is (a tqdm bar on stderr where `progress`), and the block
+    is held to `budget` seconds (None: none) with `spent` already gone: once a piece has
+    taken PILOT seconds, its time so far carried to its end, plus the pieces before it and
+    those still planned (`plan`: their costs relative to this one's, two_tolerances declares
+    its second run), is the predicted cost, checked as it goes; over the budget the piece
+    stops there (OverBudget), a few seconds in rather than at the end."""
+
+    PILOT = 1.0  # s of a run before its prediction is trusted
+    EVERY = 100  # evaluations of the right-hand side between two looks at the clock
+
+    def __init__(self, label: str, budget: float | None = None, progress: bool = False, spent: float = 0.0):
+        self.label, self.budget, self.progress = label, budget, progress
+        self.spent, self.later, self.runs = spent, [], 0  # spent: the command's time before the block
+
+    def __enter__(self):
+        global WATCH
+        self.saved, WATCH = WATCH, self
+        return self
+
+    def __exit__(self, *exc):
+        global WATCH
+        WATCH = self.saved
+        return False
+
+    def plan(self, weights) -> None:
+        """The pieces of work to come, each one's cost relative to the first of them."""
+        self.later = list(weights)
+
+    def meter(self, what: str):
+        """(tick(fraction done), done()) of one piece of work, `what`: its bar, and, once it
+        has taken PILOT seconds, its time carried to its end and to the planned pieces after
+        it, plus what the block spent before, against the budget (OverBudget)."""
+        import sys
+        import time
+
+        weight = self.later.pop(0) if self.later else 1.0
+        after = sum(self.later) / weight  # the planned pieces after this one, in units of this one
+        bar = None
+        if self.progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=100, desc=f"{self.label} ({what})", unit="%", leave=False, file=sys.stderr)
+        start = time.perf_counter()
+
+        def tick(frac: float) -> None:
+            frac = min(max(frac, 0.0), 1.0)
+            took = time.perf_counter() - start
+            if bar is not None and int(100 * frac) > bar.n:
+                bar.update(int(100 * frac) - bar.n)  # drawn at tqdm's own pace
+            if self.budget is not None and took >= self.PILOT and frac > 0:
+                predicted = self.spent + took / frac * (1 + after)
+                if predicted > self.budget:
+                    done()
+                    raise OverBudget(predicted, f"measured on {100 * frac:.2g}% of {what}", self.budget)
+
+        def done() -> None:
+            nonlocal bar
+            if bar is not None:
+                bar.close()
+                bar = None
+
+        def finished() -> None:
+            self.spent += time.perf_counter() - start
+            done()
+
+        return tick, finished
+
+    def wrap(self, fun, t0: float, t1: float):
+        """fun(t, y) for solve_ivp, watched over [t0, t1]; call its done() after the run."""
+        self.runs += 1
+        tick, finished = self.meter(f"integration {self.runs}")
+        calls, span = [0], (t1 - t0) or 1.0
+
+        def rhs(tt, y):
+            calls[0] += 1
+            if calls[0] % self.EVERY == 0:
+                tick((tt - t0) / span)
+            return fun(tt, y)
+
+        rhs.done = finished
+        return rhs
+
+
 def two_tolerances(run, rtol: float, finer: float = 1e-2):
     """An integrated answer and its error estimate by two tolerances (the `motion` question's
     integrated levels): run(r) -> the answer (times, columns) at relative tolerance r; the
@@ -204,6 +302,8 @@ def two_tolerances(run, rtol: float, finer: float = 1e-2):
     from the run at rtol: an estimate of the coarser run's global error that bounds the
     finer one's where the error falls with the tolerance (not near a separatrix:
     docs/gimbal.md)."""
+    if WATCH is not None:  # the second run's cost, of the first's: DOP853's steps go as rtol^(1/8)
+        WATCH.plan([1.0, finer ** (-1 / 8)])  # (measured 1.70 on the torsion gyrocompass at 1e-9)
     q1 = run(rtol)
     q2 = run(rtol * finer)
     return q2, 2 * np.max(np.abs(q1 - q2), axis=0)
@@ -246,8 +346,14 @@ def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budg
             zeros = [np.zeros(v.numel()) for v in symbolic(model).inputs]
             kw["jac"] = lambda _, Y: np.asarray(J(Y, ca.DM(P), *zeros)[1])
         fun = budgeted(numpy_rhs(model, P, inputs), label or method, t[-1], budget_s, budget_steps, IntegrationBudget)
-        with np.errstate(all="ignore"):
-            sol = solve_ivp(fun, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol, **kw)
+        if WATCH is not None:
+            fun = WATCH.wrap(fun, t[0], t[-1])
+        try:
+            with np.errstate(all="ignore"):
+                sol = solve_ivp(fun, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol, **kw)
+        finally:
+            if hasattr(fun, "done"):
+                fun.done()
         if sol.status != 0 or np.shape(sol.y)[-1] != len(t):
             reached = np.asarray(sol.t, float)  # a list where the method failed at its first step
             raise FloatingPointError(f"{method} stopped at t = {reached[-1] if reached.size else t[0]:.6g} s: "

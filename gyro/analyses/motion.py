@@ -346,7 +346,20 @@ def linear_motion(red: ReducedState, z0: np.ndarray, t, corrections: int = 2, fi
     f(0)), each the linear system driven by the remainder (Duhamel's integral, r linear
     between the samples). `steps` is the fine grid's steps per sample interval (1 without a
     correction: the linear motion alone is exact on the sample grid). A grid of more than
-    FINE_BUDGET samples times states stops with IntegrationBudget, before any work."""
+    FINE_BUDGET samples times states stops with IntegrationBudget, before any work. Kept on
+    `red` for its later calls with the same arguments (a linear level, then an integrated
+    level's scale and the motion question's floor, on one motion: read-only arrays)."""
+    memo = red.__dict__.setdefault("_linear_motions", {})
+    key = (np.asarray(z0, float).tobytes(), np.asarray(t, float).tobytes(), corrections, fine)
+    if key not in memo:
+        memo.clear()  # the latest only
+        memo[key] = _linear_motion(red, z0, t, corrections, fine)
+        for a in memo[key][:2]:
+            a.flags.writeable = False
+    return memo[key]
+
+
+def _linear_motion(red: ReducedState, z0: np.ndarray, t, corrections: int, fine: int):
     t = uniform_times(t)
     A = red.first_order
     n2 = A.shape[0]
@@ -361,13 +374,40 @@ def linear_motion(red: ReducedState, z0: np.ndarray, t, corrections: int = 2, fi
     tf = np.linspace(0.0, t[-1], (t.size - 1) * per + 1)
     Ad, B0, B1 = first_order_hold(A, tf[1] - tf[0])
     zL = propagate(Ad, np.zeros((tf.size - 1, n2)), np.asarray(z0, float))
-    f = red.rhs.map(tf.size)
+    f = red.rhs.map(tf.size) if ode.WATCH is None or tf.size <= CHUNK else None
     e = np.zeros_like(zL)
-    for _ in range(corrections):
+    if f is None:  # metered: the corrections cost alike
+        ode.WATCH.plan([1.0] * corrections)
+    for c in range(corrections):
         z = zL + e
-        r = np.asarray(f(z.T)).T - z @ A.T
+        r = _remainder(red, z, f, f"the linear motion's correction {c + 1} of {corrections}") - z @ A.T
         e = propagate(Ad, r[:-1] @ B0 + r[1:] @ B1, np.zeros(n2))
     return zL[::per], e[::per], per
+
+
+CHUNK = 10_000  # samples of the remainder evaluated at a time where a watch meters it (ode.watching)
+
+
+def _remainder(red: ReducedState, z: np.ndarray, f, what: str) -> np.ndarray:
+    """f(z) over the samples z (rows): at once, or where a watch is on (ode.watching: the
+    command line's budget, a terminal's bar) in CHUNKs, metered as `what`; its evaluation
+    is most of the linear motion's work (7.6 of 9.8 s on the torsion gyrocompass over 1 s,
+    39000 samples)."""
+    watch = ode.WATCH
+    if watch is None or z.shape[0] <= CHUNK:
+        return np.asarray(f(z.T)).T
+    tick, finished = watch.meter(what)
+    out = np.empty_like(z)
+    each = red.rhs.map(CHUNK)
+    try:
+        for s in range(0, z.shape[0], CHUNK):
+            block = z[s:s + CHUNK]
+            g = each if block.shape[0] == CHUNK else red.rhs.map(block.shape[0])
+            out[s:s + CHUNK] = np.asarray(g(block.T)).T
+            tick((s + block.shape[0]) / z.shape[0])
+    finally:
+        finished()
+    return out
 
 
 def integrate_reduced(red: ReducedState, z0: np.ndarray, t, method: str = "DOP853", rtol: float = 1e-9,
@@ -439,6 +479,13 @@ FINER = 1e-2  # the integrated level's second run's tolerance, of the first's
 FLOOR = 100.0  # the integrator's absolute tolerance, at least this many eps of the reference
 
 
+def integration_floor(size, rtol: float):
+    """The integrated level's smallest estimate (absolute) of a coordinate whose unit group's
+    largest magnitude is `size`: twice the finer run's tolerance on it. Known before the
+    runs from a prediction of the motion (gyro.questions.motion.floor)."""
+    return 2 * rtol * FINER * np.asarray(size, float)
+
+
 class _Generic:
     """The motion protocol of one model: INITIAL over its reduced coordinates (`<c>_0`, a
     displacement from the reference, `<c>_d0`, a rate offset, all 0 by default), Motion and
@@ -465,6 +512,8 @@ class _Generic:
             raise ParameterError(f"--set {bad[0]}: the initial condition must be a finite number")
         z0 = np.array([vals[f"{c}_0"] for c in self.reduced] + [vals[f"{c}_d0"] for c in self.reduced])
         return _Motion(self.model, dict(params), z0)
+
+    integration_floor = staticmethod(integration_floor)
 
     def motion_answer(self, motion, t, method: str = "linear", rtol: float = 1e-9, cap_of: str = CAP_OF[0]):
         """The reduced coordinates q_ref + x at the times t (times, n) and an estimate of each
@@ -521,7 +570,8 @@ def motion_answer(red: ReducedState, z0: np.ndarray, t, units: list, method: str
     zL = linear_motion(red, z0, t, CORRECTIONS, FINE)[0]
     scale = np.array([np.max(np.abs(zL[:, :n])), np.max(np.abs(zL[:, n:]))])
     q, est = ode.two_tolerances(lambda r: integrate_reduced(red, z0, t, method, r, scale, FLOOR), rtol, FINER)
-    return q, np.maximum(est, 2 * rtol * FINER * group_max(np.max(np.abs(q), axis=0), units))
+    return q, np.maximum(est, integration_floor(group_max(np.max(np.abs(q), axis=0), units), rtol))
+
 
 
 def for_model(model) -> _Generic:

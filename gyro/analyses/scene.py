@@ -63,6 +63,9 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
             trial.code[pending], trial.missing = NOT_ANSWERED, ", ".join(missing)
             continue
         pre = B.apriori[:, idx].max(axis=1) if idx else np.zeros(pending.size)
+        if hasattr(q, "floor") and idx:  # what the level cannot go below, known before it runs
+            sub_opts = q.subset(opts, pending, N) if hasattr(q, "subset") else opts
+            pre = np.maximum(pre, q.floor(model, lv, P[pending], sub_opts))
         beyond = B.bad
         # a level with a certificate may prove the tolerance itself where its own bound is larger
         certifying = bool(lv.evaluator.get("certify")) and hasattr(q, "certify")

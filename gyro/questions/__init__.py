@@ -27,6 +27,11 @@ A question module has NAME (the command line's name) and:
   what the certificates of the levels a set tries share (made once per set), an object
   with `take(rows)` whose view certify gets as `data=`.
 
+- optionally `floor(model, level, P, opts) -> (sets,)`: per set, a bound below which the
+  level cannot answer the requested quantities, known before it runs (an integrator's
+  tolerance on the motion's size): the selector passes the level over where it is above
+  the tolerance, as it does for the a-priori part of a bound (gyro.analyses.scene).
+
 - optionally OPTIONS: {flag: help} of the command-line options it takes (`gyro scene`
   registers every question's and refuses one the question asked does not take), and
   `options(model, P, tol, given, initial) -> opts`: `given` {flag: text} parsed and checked

@@ -133,13 +133,97 @@ def subset(opts: dict, rows: np.ndarray, n: int) -> dict:
     return out
 
 
+def _initial(mod, opts) -> dict:
+    init = {k: v[1] for k, v in mod.INITIAL.items()}  # (unit, default, description)
+    init.update(opts.get("initial", {}))
+    return init
+
+
+_MOTIONS: dict = {}  # (module, model, set, initial) -> its Motion, the latest few: one motion for
+# every level that a set tries and for the floor, which share its work (its linear motion)
+
+
+def _motions(mod, model, level, P, init):
+    """(k, a function making the module's Motion of set k: it may refuse the set) for each
+    set of P."""
+    N = P.shape[0]
+    for k in range(N):
+        ic = {n: float(np.broadcast_to(v, (N,))[k]) for n, v in init.items()}
+        key = (level.evaluator["module"], str(model.directory), P[k].tobytes(), tuple(sorted(ic.items())))
+
+        def made(k=k, ic=ic, key=key):
+            if key not in _MOTIONS:
+                _MOTIONS[key] = mod.Motion(dict(zip(model.param_names, map(float, P[k]))), **ic)
+                while len(_MOTIONS) > 8:
+                    del _MOTIONS[next(iter(_MOTIONS))]
+            return _MOTIONS[key]
+
+        made.initial = ic
+        yield k, made
+
+
+def floor(model, level, P, opts) -> np.ndarray:
+    """Per set, a bound below which `level` cannot answer, known before it runs (the selector
+    passes a level over where it is above the tolerance, gyro.analyses.scene): an integrated
+    level's estimate is at least its module's integration_floor of each coordinate's size
+    (gyro.analyses.motion: the finer run's tolerance), over the error's scale. The motion is
+    predicted by the module's linear level within its own estimate d (per coordinate, over
+    the horizon): a size of at least max|q_L| - d, a scale of at most the linear motion's
+    plus 2|d| (the excursion) or max|q_L| + d (the magnitude). 0 where nothing is known (a
+    linear level, a module without integration_floor, a linear motion without an estimate).
+    Measured on the torsion gyrocompass's DOP853 level at rtol 1e-9 over 1 s: 1.41e-11
+    (its bound found there is 2.08e-8, the two runs' difference); `--tol 1e-13` is refused
+    without integrating (it integrated for 38 s before)."""
+    from gyro import ode
+    from gyro.errors import ParameterError
+
+    out = np.zeros(P.shape[0])
+    mod = _analysis(level, model)
+    if level.evaluator.get("method") == "linear" or not hasattr(mod, "integration_floor"):
+        return out
+    t, kind, rtol = times(opts), _declared(model)["scale"], level.evaluator.get("rtol", 1e-10)
+    for k, motion in _motions(mod, model, level, P, _initial(mod, opts)):
+        try:  # the linear level's answer (its work kept on the motion where it ran before)
+            with _watched(level):
+                qL, d = mod.motion_answer(motion(), t, "linear")
+        except ode.OverBudget as exc:
+            raise ParameterError(_over_budget(model, P[k], motion.initial, t[-1], level.name, exc, opts)) from None
+        except (ArithmeticError, ValueError, RuntimeError):
+            continue
+        if not (np.all(np.isfinite(qL)) and np.all(np.isfinite(d))):
+            continue
+        size = np.maximum(np.max(np.abs(qL), axis=0) - d, 0.0)
+        if kind == "excursion":
+            scale = _scale(qL, kind) + 2 * float(np.sqrt(np.sum(d ** 2)))
+        else:
+            scale = np.maximum(np.max(np.abs(qL), axis=0) + d, 1.0)
+        with np.errstate(all="ignore"):
+            f = np.max(mod.integration_floor(size, rtol) / scale)
+        out[k] = f if np.isfinite(f) else 0.0
+    return out
+
+
+def _watched(level):
+    """A level's long work shows how far it is on a terminal, and is held to the command
+    line's budget by its cost predicted as it goes (gyro.ode.watching)."""
+    import sys
+    import time
+
+    from gyro import executor, ode
+
+    spent = time.perf_counter() - executor.STARTED if executor.BUDGET is not None else 0.0
+    return ode.watching(level.name, executor.BUDGET, sys.stderr.isatty(), spent)
+
+
 def answer(model, level, P, opts) -> Answer:
+    from gyro import ode
+    from gyro.errors import ParameterError
+
     if level.evaluator.get("kind") != "trajectory":
         raise unknown_kind(NAME, level)
     mod = _analysis(level, model)
     t = times(opts)
-    init = {k: v[1] for k, v in mod.INITIAL.items()}  # (unit, default, description)
-    init.update(opts.get("initial", {}))
+    init = _initial(mod, opts)
     kind = _declared(model)["scale"]
     N, nc = P.shape[0], len(quantities(model, opts))
     values = np.full((N, nc, t.size), np.nan)
@@ -147,12 +231,13 @@ def answer(model, level, P, opts) -> Answer:
     scales = np.full((N, nc), np.nan)
     failed = np.full(N, "", object)
     extra = {k: level.evaluator[k] for k in PASSED if k in level.evaluator}
-    for k in range(N):
-        params = dict(zip(model.param_names, map(float, P[k])))
-        ic = {n: float(np.broadcast_to(v, (N,))[k]) for n, v in init.items()}
+    for k, motion in _motions(mod, model, level, P, init):
         try:
-            q, e = mod.motion_answer(mod.Motion(params, **ic), t, level.evaluator["method"],
-                                     level.evaluator.get("rtol", 1e-10), **extra)
+            with _watched(level):
+                q, e = mod.motion_answer(motion(), t, level.evaluator["method"], level.evaluator.get("rtol", 1e-10),
+                                         **extra)
+        except ode.OverBudget as exc:  # the request's, not the set's: raised past the next clause
+            raise ParameterError(_over_budget(model, P[k], motion.initial, t[-1], level.name, exc, opts)) from None
         except (ArithmeticError, ValueError, RuntimeError) as exc:  # a refusal or a failure: its reason
             failed[k] = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             continue
@@ -164,6 +249,17 @@ def answer(model, level, P, opts) -> Answer:
         elif not np.all(np.isfinite(scales[k])):
             failed[k] = "the motion does not move: no scale for a relative error"
     return Answer(values, est, failed, {"t": np.broadcast_to(t, (N, t.size)), "scale": scales})
+
+
+def _over_budget(model, p, init: dict, horizon: float, level: str, exc, opts) -> str:
+    """The one line of a motion whose work is over the command line's budget (`init`: the
+    set's initial conditions)."""
+    extra = initial_conditions(model)
+    w = _fastest(model, p[None, :], {n: v for n, v in init.items() if n in extra}, extra)
+    given = "" if "horizon" in opts else " (the default)"
+    return (f"--horizon {horizon:g}{given}: {level} follows {horizon * w / (2 * np.pi):.3g} periods of the "
+            f"fastest motion ({w:.4g} rad/s), about {exc.seconds:.0f} s in this process ({exc.measured}), "
+            f"over the command line's budget of {exc.budget:.0f} s: a shorter --horizon, or a larger --tol")
 
 
 def edges(model, ans: Answer, bound: np.ndarray, idx, answered) -> np.ndarray:

@@ -110,7 +110,7 @@ MULTISTEP = {"adams": "functional", "bdf": "newton"}  # CVODES' method and its n
 def _options(steps: int, rtol_scale: float, multistep: str = "adams") -> dict:
     return {"abstol": ATOL * rtol_scale, "reltol": RTOL * rtol_scale, "max_num_steps": int(steps),
             "linear_multistep_method": multistep, "nonlinear_solver_iteration": MULTISTEP[multistep],
-            "disable_internal_warnings": True}
+            **ode.CASADI_QUIET}  # no CasADi warning of a NaN rate near +-90 deg: the error says it
 
 
 CHECK_POINTS = 1001  # the motion is checked for +-90 deg at these times of the horizon besides the asked ones

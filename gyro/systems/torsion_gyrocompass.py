@@ -69,6 +69,7 @@ for _c in REDUCED:
 # 'toward_the_cap', docs/hierarchy.md) and shared by the generic machinery, which keeps them
 # (gyro.analyses.motion: FACTOR, CAP, ROUNDING, CORRECTIONS, FINE, FINER, FLOOR)
 CAP, FINE, CORRECTIONS, FLOOR = generic.CAP, generic.FINE, generic.CORRECTIONS, generic.FLOOR
+integration_floor = generic.integration_floor  # the motion question's floor of the DOP853 level
 
 
 class Motion:

@@ -724,9 +724,10 @@ def _bound_grid(values: dict, m):
 EDGE = float(np.arccos(SINGULAR_COS))  # a tube past this angle reaches the singularity
 
 
-def _enclosure(values: dict, g, own: dict, r: float):
+def _enclosure(values: dict, g, own: dict, r: float, limit: float = np.inf):
     """(the largest |P_level - P_full| over the horizon, the largest |G (s - s_l)|) with the
-    tube constants of radius r (see above); inf where the tube reaches +-90 deg."""
+    tube constants of radius r (see above); inf where the tube reaches +-90 deg, or where
+    |G (s - s_l)| reaches `limit` (the image point's error is at least that: rho^2 >= 1)."""
     H0 = abs(float(values["H"]))
     S = np.stack([g.alpha, g.beta, g.H], axis=-1)
     cb = np.cos(g.beta)
@@ -738,7 +739,7 @@ def _enclosure(values: dict, g, own: dict, r: float):
     Gdot = np.stack([-np.tan(g.beta) * rate[:, 1], np.zeros_like(cb), np.zeros_like(cb)], axis=-1)
     kappa = np.einsum("nij,nj->ni", own["Dpi"], rate)  # the nutation centre's drift along the level
     c = _over_tube(values, S, own, Gd, Gdot, kappa, r)
-    if not (np.all(c["mmin"] > 0) and np.all(c["Lpi"] < 1)):
+    if not all(np.all(np.isfinite(x)) for x in c.values()) or not (np.all(c["mmin"] > 0) and np.all(c["Lpi"] < 1)):
         return float("inf"), float("inf")
     dn = np.linalg.norm(Gd * dl, axis=-1)
     dstep = np.maximum(dn[:-1], dn[1:]) + np.abs(dn[1:] - dn[:-1])
@@ -747,21 +748,21 @@ def _enclosure(values: dict, g, own: dict, r: float):
     # om(0) = -eta(s(0)), the full state at t = 0 the level's; delta(0) = 0
     E = worst = 0.0
     k1 = 1 / (1 - c["Lpi"])
-    with np.errstate(over="ignore", invalid="ignore"):
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused below, not warned
         gl = np.exp(c["lam"] * h)
         gm = np.exp((c["mu"] + c["L"] * c["Lpi"] * k1) * h)
-    for k in range(len(h)):
-        Wsup = (W + h[k] * c["rho"][k]) * max(1.0, gl[k])  # |w|_Mr over the step
-        W = W * gl[k] + h[k] * c["rho"][k] * max(1.0, gl[k])
-        wmax = c["eta"][k] + Wsup / np.sqrt(c["mmin"][k])  # |w| <= |eta| + |om| over the step
-        F = (c["L"][k] * c["PK"][k] * k1[k] * wmax + c["s1"][k] * wmax + c["s2"][k] * wmax**2 / 2
-             + c["chi"][k] + dstep[k])
-        Esup = (E + h[k] * F) * max(1.0, gm[k])
-        E = E * gm[k] + h[k] * F * max(1.0, gm[k])
-        here = (Esup + c["PK"][k] * wmax) * k1[k]  # |G (s - s_l)| over the step
-        if not np.isfinite(here):  # an overflow (inf, or inf * 0): no enclosure
-            return float("inf"), float("inf")
-        worst = max(worst, here)
+        for k in range(len(h)):
+            Wsup = (W + h[k] * c["rho"][k]) * max(1.0, gl[k])  # |w|_Mr over the step
+            W = W * gl[k] + h[k] * c["rho"][k] * max(1.0, gl[k])
+            wmax = c["eta"][k] + Wsup / np.sqrt(c["mmin"][k])  # |w| <= |eta| + |om| over the step
+            F = (c["L"][k] * c["PK"][k] * k1[k] * wmax + c["s1"][k] * wmax + c["s2"][k] * wmax**2 / 2
+                 + c["chi"][k] + dstep[k])
+            Esup = (E + h[k] * F) * max(1.0, gm[k])
+            E = E * gm[k] + h[k] * F * max(1.0, gm[k])
+            here = (Esup + c["PK"][k] * wmax) * k1[k]  # |G (s - s_l)| over the step
+            if not here < limit:  # an overflow (inf, or inf * 0), or past the limit: no enclosure worth offering
+                return float("inf"), float("inf")
+            worst = max(worst, here)
     # the sphere's distance within max(1, cos beta / cos beta_l) |G e| over the tube, the image
     # point within rho^2 of it (the gnomonic projection's largest scale), both largest over the tube
     cos_b = np.cos(np.maximum(np.abs(g.beta) - worst, 0.0)) / np.abs(cb)
@@ -771,17 +772,18 @@ def _enclosure(values: dict, g, own: dict, r: float):
     return float(np.max(np.maximum(1.0, cos_b) / c_far**2) * worst), worst
 
 
-def model_error(values: dict, m) -> float:
+def model_error(values: dict, m, limit: float = np.inf) -> float:
     """The enclosure of the largest |P_level - P_full| over the horizon (absolute; the
     derivation above); inf where the level refuses: the tube does not close within BOOTSTRAP
-    tries, reaches +-90 deg, or the grid would be too fine."""
+    tries, reaches +-90 deg, or the grid would be too fine; inf also where a try's bound
+    reaches `limit` (a bound no use: the caller's relative bound would be >= 1)."""
     g = _bound_grid(values, m)
     if g is None:
         return float("inf")
     own = _at(values, np.stack([g.alpha, g.beta, g.H], axis=-1))
     r = 0.0
     for _ in range(BOOTSTRAP):
-        err, worst = _enclosure(values, g, own, r)
+        err, worst = _enclosure(values, g, own, r, limit)
         if not np.isfinite(worst):
             return float("inf")
         if worst < r:  # closed: the tube of radius r holds the full motion over the horizon
@@ -811,7 +813,7 @@ def bound(values: dict, m) -> float:
     scale = _scale(m)
     if not scale > 0:
         return float("inf")
-    model = 0.0 if m.level == "full" else model_error(values, m)
+    model = 0.0 if m.level == "full" else model_error(values, m, limit=scale)
     if not model / scale < 1:  # no bound: the integrator's runs are not needed
         return float("inf")
     b = (model + integration_error(values, m)) / scale

@@ -522,11 +522,13 @@ MIN_SAMPLES = 41  # the bound's grid has at least these
 BOOTSTRAP = 6  # tries to close the tube's radius
 TUBE_GROWTH = 2.0  # a try that does not close raises the radius to this times its bound
 BALL_ALLOWANCE = 2.0  # the tube's constant: the centre's plus this times the axial points' spread
-# and each step's plus this times the constant's largest magnitude over the horizon (measured:
-# random points of the ball and a 4x denser grid exceeded the two allowances above by at most 6e-6
-# and 0 of that magnitude where the tube's radius is above 1e-10 rad, 8e-3 below it; |rho1|, second
-# order and computed with cancellation, by up to 0.97 of it on motions of rounding size: its own
-# largest over the horizon is added, which moves the bound by at most 3 % elsewhere)
+# and each step's plus this times the constant's largest magnitude over the horizon (measured,
+# `python -m bench.precession_bounds 11 --allowances 16`: random points of the ball and a 4x denser
+# grid exceeded the two allowances above by at most 3e-7 of that magnitude where the tube's radius
+# is 1e-10 rad or more, 2e-5 at 1e-20..1e-10 rad, 0.19 on motions of rounding size (a model term of
+# 1e-26 against the integrator's 1e-12); |rho1|, second order and computed with cancellation, by up
+# to 1.0 on motions of 1e-13 rad and less: all of its largest over the horizon is added, which moves
+# the bound by at most 3 % elsewhere)
 FLOOR_ALLOWANCE = {None: 1e-2, "rho": 1.0}
 
 

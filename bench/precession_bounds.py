@@ -16,10 +16,10 @@ Several JSON files from --out are summarised together by `--summary FILE ...`.
 `--allowances N`: the sampled maxima of the enclosure's constants checked on N answered sets
 (`rigorous`, seed SEED): 60 random points of the tube's ball at every sample against the
 centre plus twice the axial spread, and a 4x denser grid (at the motion) against the larger
-end plus the ends' difference; prints the largest excess of each constant as a fraction of
-its largest magnitude over the horizon, for tubes of 1e-10 rad and wider, 1e-20..1e-10 rad,
-and narrower (motions of rounding size): the numbers FLOOR_ALLOWANCE in
-gyro/systems/gimbal_precession.py is set from.
+end plus the ends' difference (|rho1| with its floor RHO1_FLOOR |rho0|); prints the largest
+excess of each constant as a fraction of its largest magnitude over the horizon, for tubes of
+1e-10 rad and wider, 1e-20..1e-10 rad, and narrower (motions of rounding size): the numbers
+FLOOR_ALLOWANCE and RHO1_FLOOR in gyro/systems/gimbal_precession.py are set from.
 """
 from __future__ import annotations
 
@@ -185,7 +185,8 @@ def allowances(seed, n, pr):
             cr = pr._constants(pr._at(v, S + d / Gd), Gd, Gdot, kappa)
             for k in centre:
                 dev = (centre[k] - cr[k]) if k == "mmin" else (cr[k] - centre[k])
-                into[k] = max(into.get(k, 0.0), float(np.max(dev - pr.BALL_ALLOWANCE * spread[k])) / scale[k])
+                extra = pr.RHO1_FLOOR * float(np.max(centre["rho0"])) if k == "rho" else 0.0
+                into[k] = max(into.get(k, 0.0), float(np.max(dev - pr.BALL_ALLOWANCE * spread[k] - extra)) / scale[k])
         tf = np.linspace(0, float(g.t[-1]), 4 * (len(g.t) - 1) + 1)
         Sf, Gdf, ownf, Gdotf, kf = frame(pr.simulate(v, tf, "rigorous"))
         cf = pr._constants(ownf, Gdf, Gdotf, kf)
@@ -195,6 +196,8 @@ def allowances(seed, n, pr):
                 dev = (np.minimum(a, b) - np.abs(b - a)) - np.minimum.reduceat(x[:-1], np.arange(0, len(x) - 1, 4))
             else:
                 dev = np.maximum.reduceat(x[:-1], np.arange(0, len(x) - 1, 4)) - (np.maximum(a, b) + np.abs(b - a))
+            if k == "rho":
+                dev = dev - pr.RHO1_FLOOR * float(np.max(cf["rho0"]))
             key = "between " + k
             into[key] = max(into.get(key, 0.0), float(np.max(dev)) / max(float(np.max(np.abs(x))), 1e-300))
     return worst

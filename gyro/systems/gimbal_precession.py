@@ -507,8 +507,8 @@ def image_error(a, b) -> float:
 # Every constant is the largest over the tube |G (s - s_l)| <= r about the level's motion
 # (the centre and the six axial points at radius r, with twice their spread as the
 # allowance for the rest of the ball) and over each step (the larger end plus the steps'
-# difference as the allowance between samples, plus a floor: FLOOR_ALLOWANCE). The radius is closed by a bootstrap: the
-# bound computed with the constants of radius r must come out below r, else r is raised;
+# difference as the allowance between samples, plus a floor: FLOOR_ALLOWANCE). The radius
+# is closed by a bootstrap: the bound computed with the constants of radius r must come out below r, else r is raised;
 # a tube that reaches beta or alpha = +-90 deg, or no closing within BOOTSTRAP tries: the
 # level refuses (the bound is infinite).
 # The integrator's term: the answer (Adams, rtol 1e-12) against an independent method (BDF
@@ -522,14 +522,15 @@ MIN_SAMPLES = 41  # the bound's grid has at least these
 BOOTSTRAP = 6  # tries to close the tube's radius
 TUBE_GROWTH = 2.0  # a try that does not close raises the radius to this times its bound
 BALL_ALLOWANCE = 2.0  # the tube's constant: the centre's plus this times the axial points' spread
-# and each step's plus this times the constant's largest magnitude over the horizon (measured,
-# `python -m bench.precession_bounds 11 --allowances 16`: random points of the ball and a 4x denser
-# grid exceeded the two allowances above by at most 3e-7 of that magnitude where the tube's radius
-# is 1e-10 rad or more, 2e-5 at 1e-20..1e-10 rad, 0.19 on motions of rounding size (a model term of
-# 1e-26 against the integrator's 1e-12); |rho1|, second order and computed with cancellation, by up
-# to 1.0 on motions of 1e-13 rad and less: all of its largest over the horizon is added, which moves
-# the bound by at most 3 % elsewhere)
-FLOOR_ALLOWANCE = {None: 1e-2, "rho": 1.0}
+# and each step's plus this times the constant's largest magnitude over the horizon; |rho1|, second
+# order and computed with cancellation, also RHO1_FLOOR times |rho0|'s largest (measured, `python -m
+# bench.precession_bounds 11 --allowances 16`: random points of the ball and a 4x denser grid
+# exceeded the sampled maxima by 3e-7 of that magnitude (|rho1|) where the tube's radius is 1e-10
+# rad or more, 2e-5 at 1e-20..1e-10 rad (|rho1| 0.97, where it is 1e-7..1e-5 of |rho0|), none
+# with the floors; 0.98 on motions of rounding size, a model term of 1e-26 against the
+# integrator's 1e-12)
+FLOOR_ALLOWANCE = 1e-2
+RHO1_FLOOR = 1e-4
 
 
 def _scale(m) -> float:
@@ -606,7 +607,7 @@ def _expressions() -> dict:
     KiM = ca.solve(Kg, Mr)
     sigma = (ca.jtimes(B, s, sdot) @ KiM @ vw + B @ (ca.jtimes(KiM, s, sdot) @ vw
                                                       - ca.solve(Kg, ca.substitute(hrest, v, vw))))
-    return {"p": p, "s": s, "w": w, "o": o, "Phi": Phi, "DPhi": DPhi, "f": f, "eta": eta, "energy": energy,
+    return {"p": p, "s": s, "w": w, "o": o, "Phi": Phi, "DPhi": DPhi, "f": f, "eta": eta, "energy": energy, "rho0": rho0,
             "Mr": Mr, "BKM": B @ KiM, "Dpi": ca.jacobian(B @ KiM @ f, s), "sigma": sigma}
 
 
@@ -624,7 +625,7 @@ def _tube_function():
     Q = ca.hessian(energy, o)[0] / 2
     s1 = ca.jacobian(sigma, w)
     s2 = [ca.hessian(sigma[i], w)[0] for i in range(3)]
-    outs = [e["Phi"], e["DPhi"], rho1, Q, e["Mr"], e["eta"], e["BKM"], e["Dpi"], sigma, s1, *s2]
+    outs = [e["Phi"], e["DPhi"], rho1, Q, e["Mr"], e["eta"], e["BKM"], e["Dpi"], sigma, s1, *s2, e["rho0"]]
     outs = [ca.substitute(ca.substitute(ca.vec(x), w, ca.DM.zeros(2)), o, ca.DM.zeros(2)) for x in outs]
     return ca.Function("precession_tube", [e["p"], e["s"]], [ca.vertcat(*outs)], {"cse": True})
 
@@ -633,7 +634,7 @@ def _at(values: dict, S: np.ndarray) -> dict:
     """The tube function at the states S (n, 3), unpacked (each (n, ...))."""
     col = np.array(_tube_function()(vector(values), S.T)).T
     shapes = {"Phi": (3,), "DPhi": (3, 3), "rho1": (2,), "Q": (2, 2), "Mr": (2, 2), "eta": (2,), "BKM": (3, 2),
-              "Dpi": (3, 3), "sigma": (3,), "s1": (3, 2), "s2": (3, 2, 2)}
+              "Dpi": (3, 3), "sigma": (3,), "s1": (3, 2), "s2": (3, 2, 2), "rho0": (2,)}
     out, k = {}, 0
     for name, shape in shapes.items():
         size = int(np.prod(shape))
@@ -662,6 +663,7 @@ def _constants(c: dict, Gd: np.ndarray, Gdot: np.ndarray, kappa: np.ndarray) -> 
     Wsym = (GD + np.transpose(GD, (0, 2, 1))) / 2 + np.einsum("ni,ij->nij", Gdot, np.eye(3))
     return {"lam": np.linalg.eigvalsh(Li @ Qs @ np.transpose(Li, (0, 2, 1)))[:, -1],
             "rho": np.linalg.norm(np.einsum("nij,nj->ni", Li, c["rho1"]), axis=-1),  # |rho1|_Mr^-1
+            "rho0": np.linalg.norm(np.einsum("nij,nj->ni", Li, c["rho0"]), axis=-1),  # its floor's scale
             "eta": np.linalg.norm(c["eta"], axis=-1), "eta_M": np.sqrt(np.einsum("ni,nij,nj->n", c["eta"], Mr, c["eta"])),
             "mmin": np.linalg.eigvalsh(Mr)[:, 0], "mu": np.linalg.eigvalsh(Wsym)[:, -1], "L": _norm2(GD),
             "PK": _norm2(Gd[:, :, None] * c["BKM"]), "Lpi": _norm2(Gd[:, :, None] * c["Dpi"] / Gd[:, None, :]),
@@ -673,7 +675,8 @@ def _over_tube(values, S, own, Gd, Gdot, kappa, r) -> dict:
     """Each constant's largest over the tube of radius r about the states S: the centre's
     plus BALL_ALLOWANCE times the largest spread of the six axial points (for mmin the
     smallest, the same way); then over each step: the larger end plus the ends' difference,
-    plus FLOOR_ALLOWANCE (per constant) times its largest magnitude over the horizon.
+    plus FLOOR_ALLOWANCE times its largest magnitude over the horizon (|rho1| also RHO1_FLOOR
+    times |rho0|'s largest).
     Returns per step (n - 1); `own` the tube function at S."""
     centre = _constants(own, Gd, Gdot, kappa)
     if r > 0:
@@ -692,7 +695,9 @@ def _over_tube(values, S, own, Gd, Gdot, kappa, r) -> dict:
     step = {}
     for k, v in tube.items():
         a, b = v[:-1], v[1:]
-        floor = FLOOR_ALLOWANCE.get(k, FLOOR_ALLOWANCE[None]) * float(np.max(np.abs(v)))
+        floor = FLOOR_ALLOWANCE * float(np.max(np.abs(v)))
+        if k == "rho":
+            floor += RHO1_FLOOR * float(np.max(tube["rho0"]))
         step[k] = (np.minimum(a, b) - np.abs(b - a) - floor) if k == "mmin" else (np.maximum(a, b) + np.abs(b - a) + floor)
     return step
 

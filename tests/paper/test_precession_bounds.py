@@ -130,7 +130,7 @@ def test_the_flat_ring_on_a_turning_base():
             v0, ref0 = _reference({**s, "C1": 2e-3, "C2": 2e-3}, t)
             m0 = pr.simulate(v0, t, "rigorous")
             assert _error(m0, ref0) <= pr.bound(v0, m0)
-            assert _error(ref, ref0) > pr.bound(v, pr.simulate(v, t, "rigorous"))  # 2.5e-2 against 5.4e-3
+            assert _error(ref, ref0) > pr.bound(v, pr.simulate(v, t, "rigorous"))  # 2.5e-2 against 5.8e-3
 
 
 # a set with every term of the proof on: friction in all three axes, a flat ring off its

@@ -155,7 +155,7 @@ def bench_tolerance(n: int) -> dict:
                       scheduler="local", harmonics=HARMONICS, band=0.02, progress=True)
     wall = time.perf_counter() - t0
     study.plot(RESULTS / "tolerance_histograms.png")
-    study.sensitivities.tornado(RESULTS / "tolerance_tornado.png",
+    study.sensitivities.plot(RESULTS / "tolerance_tornado.png",
                                 title=f"{model.meta['title']}: relative sensitivities at the paper's set")
     print(study.table(), flush=True)
     print(f"tolerance: {n} samples in {wall:.1f} s on {os.cpu_count()} cores (goal for 1e7: 600 s)", flush=True)

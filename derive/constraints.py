@@ -34,11 +34,11 @@ from __future__ import annotations
 
 import dataclasses
 from itertools import combinations
+from types import SimpleNamespace
 
 import sympy as sp
 
 from derive import mechanics as mech
-from derive.derivation import Derivation
 from derive.model import TIME, Load, Model, Unsupported
 
 
@@ -57,6 +57,12 @@ def _constraints(model: Model) -> list:
     return phis
 
 
+def _tidy(e):
+    """A solution entry in its simplest form: cancel, exact and cheap, for a rational
+    function of its symbols (y/R: 1 ms against simplify's 17 ms); simplify otherwise."""
+    return sp.cancel(e) if e.is_rational_function() else sp.simplify(e)
+
+
 def solve_dependent(model: Model):
     """(indices of the dependent coordinates, their solution) where the constraints are
     linear in some m coordinates with a Jacobian free of them and not identically singular
@@ -73,7 +79,7 @@ def solve_dependent(model: Model):
         if J.has(*dq) or sp.expand(J.det()) == 0:
             continue
         rest = Phi.xreplace({x: 0 for x in dq})
-        sol = (-J.LUsolve(rest)).applyfunc(sp.simplify)
+        sol = (-J.LUsolve(rest)).applyfunc(_tidy)
         return sorted(deps), dict(zip(dq, sol))
     return None
 
@@ -123,10 +129,10 @@ def eliminate(model: Model, deps: list, sol: dict) -> tuple[Model, dict]:
     return out, info
 
 
-def multipliers(model: Model, Q, steps, d: Derivation) -> Derivation:
-    """The derivation d with Lagrange multipliers (module docstring): its equations, operator
-    and B filled (derive/passes/constraints.py chooses this route)."""
-
+def multipliers(model: Model) -> tuple[Model, SimpleNamespace, dict]:
+    """The multipliers route chosen (derive/passes/constraints.py): what it refuses, and
+    (the model with the quantities `constraints` and `constraint_forces`, what the equation,
+    reference, operator and input passes take of the constraints, the metadata)."""
     phis = _constraints(model)
     m, n = len(phis), len(model.q)
     for what, present in (("cyclic coordinates", model.cyclic), ("steady motions", model.steady),
@@ -137,59 +143,15 @@ def multipliers(model: Model, Q, steps, d: Derivation) -> Derivation:
     if any(c.free_symbols & explicit for c in phis):
         raise Unsupported(f"{model.name}: a holonomic constraint with explicit time that cannot be solved for "
                           "dependent coordinates (multipliers at a moving constraint are not derived)")
-    q, qd, qdd = list(model.q), list(model.qd), list(model.qdd)
     order = model.reduced or [c for c in model.coordinates][: n - m]
     if len(order) != n - m or not set(order) <= set(model.coordinates):
         raise Unsupported(f"{model.name}: `reduced` names the {n - m} independent coordinates of a system "
                           f"with {m} constraints on {n}")
     ind = [model.coordinates.index(c) for c in order]
     dep = [i for i in range(n) if i not in ind]
+    Phi = sp.Matrix(phis)
+    Pq = Phi.jacobian(list(model.q))
     lam = sp.symbols(f"lam1:{m + 1}")
-    with steps(f"equations with {m} Lagrange multiplier(s), mass-matrix form of n + m unknowns"):
-        Mq, f = mech.mass_matrix_form(model.lagrangian, q, qd, Q, model.signals)
-        Phi = sp.Matrix(phis)
-        Pq = Phi.jacobian(q)
-        gamma = mech.time_derivative(Pq * sp.Matrix(qd), q, qd)
-        Maug = sp.Matrix(sp.BlockMatrix([[Mq, Pq.T], [Pq, sp.zeros(m, m)]]))
-        faug = sp.Matrix(sp.BlockMatrix([[f], [-gamma]]))
-    zero_inputs = {s: 0 for s in model.input_signal_symbols}
-    rest = {v: 0 for v in qd} | {a: 0 for a in qdd} | zero_inputs
-    with steps("linear operator in the independent coordinates (sympy's linearize at rest)"):
-        E = Mq * sp.Matrix(qdd) - f
-        P_dep, P_ind = Pq.extract(list(range(m)), dep), Pq.extract(list(range(m)), ind)
-        if P_dep.det() == 0:
-            raise Unsupported(f"{model.name}: the constraints cannot be solved for the dependent coordinates "
-                              f"({', '.join(model.coordinates[i] for i in dep)}): choose others in `reduced`")
-        C = sp.zeros(n, n - m)
-        for k, i in enumerate(ind):
-            C[i, k] = 1
-        Cdep = -P_dep.inv() * P_ind
-        for r, i in enumerate(dep):
-            for k in range(n - m):
-                C[i, k] = Cdep[r, k]
-        f0 = f.subs(rest)
-        lam0 = P_dep.T.inv() * sp.Matrix([f0[i] for i in dep])
-        H = sp.zeros(n, n)
-        for j, phi in enumerate(phis):
-            H += lam0[j] * sp.hessian(phi, q)
-        E0 = E.subs({s: 0 for s in zero_inputs})
-        Mr = (C.T * E0.jacobian(qdd).subs(rest) * C)
-        Dr = (C.T * E0.jacobian(qd).subs(rest) * C)
-        Kr = (C.T * (E0.jacobian(q).subs(rest) + H) * C)
-        residual = (C.T * f0)
-        op = mech.LinearOperator(Mr, Dr, Kr)
-    rq = [q[i] for i in ind]
-    d.mass_matrix, d.forcing, d.routhian = Maug, faug, model.lagrangian
-    d.rq, d.rqd, d.rqdd, d.even = rq, [qd[i] for i in ind], [qdd[i] for i in ind], q
-    d.equilibrium_residual, d.operator, d.route_agreement, d.order = residual, op, None, order
-    d.time_dependent = TIME in (Maug.free_symbols | faug.free_symbols)
-    w = list(model.input_signal_symbols)
-    if w:
-        Bq = -E.jacobian(w).subs(rest)
-        B = (C.T * Bq)
-        keep = [j for j in range(len(w)) if any(B[i, j] != 0 for i in range(B.rows))]
-        d.inputs = [w[j] for j in keep]
-        d.input_matrix = B.extract(list(range(B.rows)), keep) if keep else None
     quantities = dict(model.quantities)
     quantities["constraints"] = (["params", "q"], [("phi", Phi), ("Phi_q", Pq)],
                                  "The holonomic constraints phi(q) (zero on a motion) and their Jacobian.")
@@ -197,7 +159,48 @@ def multipliers(model: Model, Q, steps, d: Derivation) -> Derivation:
         ["params", "q", ("multipliers", list(lam))], [("Qc", -Pq.T * sp.Matrix(lam))],
         "Constraint forces on the coordinates, -Phi_q' lambda, with lambda the last m unknowns of "
         "mass_matrix [qdd; lambda] = forcing.")
-    d.model = dataclasses.replace(model, quantities=quantities)
-    d.constraints = {"holonomic": [str(c) for c in phis], "multipliers": [str(x) for x in lam],
-                     "independent": order, "dependent": [model.coordinates[i] for i in dep]}
-    return d
+    held = SimpleNamespace(phis=phis, Pq=Pq, lam=list(lam), order=order, ind=ind, dep=dep)
+    info = {"holonomic": [str(c) for c in phis], "multipliers": [str(x) for x in lam],
+            "independent": order, "dependent": [model.coordinates[i] for i in dep]}
+    return dataclasses.replace(model, quantities=quantities), held, info
+
+
+def augmented(held, Mq: sp.Matrix, f: sp.Matrix, q: list, qd: list) -> tuple[sp.Matrix, sp.Matrix]:
+    """The equations of n + m unknowns (q'', lambda): [[Mq, Phi_q'], [Phi_q, 0]] and
+    [f; -gamma], gamma = (Phi_q q')' at q'' = 0."""
+    Pq, m = held.Pq, len(held.phis)
+    gamma = mech.time_derivative(Pq * sp.Matrix(qd), q, qd)
+    return (sp.Matrix(sp.BlockMatrix([[Mq, Pq.T], [Pq, sp.zeros(m, m)]])),
+            sp.Matrix(sp.BlockMatrix([[f], [-gamma]])))
+
+
+def projection(model: Model, held) -> sp.Matrix:
+    """C of dq = C dq_ind on the constraints: [I; -Phi_dep^-1 Phi_ind] in the coordinates'
+    order (refused where Phi_dep is singular: other independent coordinates)."""
+    Pq, ind, dep = held.Pq, held.ind, held.dep
+    m, n = len(dep), len(model.q)
+    P_dep, P_ind = Pq.extract(list(range(m)), dep), Pq.extract(list(range(m)), ind)
+    if P_dep.det() == 0:
+        raise Unsupported(f"{model.name}: the constraints cannot be solved for the dependent coordinates "
+                          f"({', '.join(model.coordinates[i] for i in dep)}): choose others in `reduced`")
+    C = sp.zeros(n, n - m)
+    for k, i in enumerate(ind):
+        C[i, k] = 1
+    Cdep = -P_dep.inv() * P_ind
+    for r, i in enumerate(dep):
+        for k in range(n - m):
+            C[i, k] = Cdep[r, k]
+    held.P_dep = P_dep
+    return C
+
+
+def constrained_operator(held, C: sp.Matrix, E0: sp.Matrix, f0: sp.Matrix, q, qd, qdd, rest: dict):
+    """The operator about rest in the independent coordinates, as sympy's linearize gives
+    it: lambda0 from the dependent rows at rest (Phi_dep' lambda0 = f_dep), then
+    M = C' Mq C, D = C' (dE/dq') C, K = C' (dE/dq + sum_j lambda0_j d2 phi_j/dq2) C."""
+    lam0 = held.P_dep.T.inv() * sp.Matrix([f0[i] for i in held.dep])
+    H = sp.zeros(len(q), len(q))
+    for j, phi in enumerate(held.phis):
+        H += lam0[j] * sp.hessian(phi, q)
+    return mech.LinearOperator(C.T * E0.jacobian(qdd).subs(rest) * C, C.T * E0.jacobian(qd).subs(rest) * C,
+                               C.T * (E0.jacobian(q).subs(rest) + H) * C)

@@ -1,7 +1,7 @@
 """The result of a derivation (derive/pipeline.py): what the output kinds of
 derive/outputs/ turn into functions and metadata. A leaf: it imports the model's data and
 the machinery's types, no step of the derivation, so that every pass of derive/passes/
-(and the multipliers of derive/constraints.py) fills it without importing another step.
+fills it without importing another step.
 
 A derivation starts as `Derivation(model)`; each pass fills its part. What one pass hands
 to a later one and no output kind reads (the Lagrangian without inputs, the kinks, the

@@ -20,6 +20,8 @@ from derive.derivation import Derivation, VariantResult  # noqa: F401  (pipeline
 from derive.model import Function, Model, Unsupported, runtime_module
 from derive.passes.variants import P_SYMBOL, Z_SYMBOL  # noqa: F401  (pipeline.P_SYMBOL, as before)
 
+passes.passes()  # the pass modules imported with the pipeline, not within the first derivation
+
 
 class Steps:
     """Prints each step of a long run with its duration, as it goes."""

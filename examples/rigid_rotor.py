@@ -163,7 +163,7 @@ if __name__ == "__main__":
     diagram, response, err = analyse(rotor)
     diagram.plot(out / "rigid_rotor_campbell.png")
     response.plot(out / "rigid_rotor_unbalance.png")
-    print(diagram.crossings_table())
+    print(diagram.table())
     peaks = response.amplitudes
     for j, name in enumerate(response.coordinates):
         i = int(peaks[:, j].argmax())

@@ -339,6 +339,87 @@ def general(M, D, K):
     return roots, est
 
 
+EQ_MOVE = 2 * EPS  # each equilibrium coordinate moved by this, relative: 4x its rounding's u |q|
+INPUT_MOVE = 4 * EPS  # each parameter moved by this, relative (as input_rounding moves them)
+
+
+def _pattern(m: int, period: int) -> np.ndarray:
+    """Signs +1/-1 over m entries, alternating in runs of `period`."""
+    return np.where((np.arange(m) // period) % 2 == 0, 1.0, -1.0)
+
+
+def equilibrium_moves(model: Model, P, qe, M, D, K):
+    """The double operator's own rounding, entrywise in absolute value, beyond what an
+    estimate of the eigenproblem at the given M, D, K sees: the largest change of M, D, K
+    over two fixed perturbations, each moving every equilibrium coordinate by EQ_MOVE and
+    every parameter by INPUT_MOVE relative, with signs alternating in runs of 1 and of 2
+    (one pattern alone leaves a product or a ratio of two inputs unmoved).
+    - The equilibrium's rounding: large where the operator turns a coordinate's absolute
+      rounding into a large relative one, the gyrohorizoncompass at epsilon0 = 89.99 deg:
+      cos(epsilon0) = 1.3e-4 from epsilon rounded by 8.4e-17 put M and D entries off by 1e-11
+      and omega3 by 6.3e-13, against an estimate of 7.3e-15 without this.
+    - The entries' own formation: an entry formed by cancellation (a K entry off by 42 eps,
+      omega2 by 4.7e-15 against 3.6e-15) moves with its inputs as it moves with the rounding
+      of its terms.
+    A coordinate that is exactly zero (a symmetric equilibrium) does not move."""
+    P, qe = np.asarray(P, dtype=float), np.asarray(qe, dtype=float)
+    out = None
+    with np.errstate(all="ignore"):  # a non-finite change stays one: no bound there
+        for period in (1, 2):
+            Pm = P * (1 + INPUT_MOVE * _pattern(P.shape[-1], period))
+            qm = qe * (1 + EQ_MOVE * _pattern(qe.shape[-1], period))
+            d = operators(model, Pm, qm)  # fresh arrays of our own: changed in place
+            for X, Y in zip(d, (M, D, K)):
+                np.abs(np.subtract(X, Y, out=X), out=X)
+            out = d if out is None else [np.fmax(a, b, out=a) for a, b in zip(out, d)]
+    return tuple(out)
+
+
+def hermitian_moves(moves, M, D, w, z) -> np.ndarray:
+    """Each root's move, relative, under an entrywise change |dM|, |dD|, |dK| of a
+    gyroscopic operator, to first order from its vector z (B, r, n): the Rayleigh functional
+    a w^2 + beta w - c moves by at most |z|^T (w^2 |dM| + w |dD| + |dK|) |z|, the root by
+    that over |2 a w + beta| (gyro.qep.rayleigh_step's estimate, with |dJ| for eps |J|)."""
+    dM, dD, dK = moves
+    x, y = np.ascontiguousarray(z.real), np.ascontiguousarray(z.imag)  # (B, r, n)
+    az = np.abs(z)
+
+    def form(u, A, v):  # u_r' A v_r for every set and root (batched matmul: the fast route)
+        return np.einsum("bri,bri->br", u, v @ A.transpose(0, 2, 1))
+
+    with np.errstate(all="ignore"):
+        num = form(az, dK, az) + w**2 * form(az, dM, az) + w * form(az, dD, az)
+        # z* M z = x'Mx + y'My (M symmetric), Im z* D z = 2 x'Dy (D skew)
+        a = form(x, M, x) + form(y, M, y)
+        beta = 2 * form(x, D, y)
+        out = num / (np.abs(2 * a * w + beta) * w)
+    return np.where(np.isfinite(out), out, np.inf)
+
+
+def general_moves(moves, M, D, K, lam, chunk=1024) -> np.ndarray:
+    """Each root's move, relative, under an entrywise change |dM|, |dD|, |dK|, for any
+    operator (damped, circulatory): x, y the singular vectors of J(lam) at its smallest
+    singular value, |y|^T (|dM| |lam|^2 + |dD| |lam| + |dK|) |x| / (|lam| |y* J'(lam) x|),
+    to first order; per set and root (B, r), inf where a root or a change is not finite."""
+    dM, dD, dK = moves
+    B, r = lam.shape
+    out = np.full((B, r), np.inf)
+    fine = np.isfinite(lam) & np.all(np.isfinite(dM) & np.isfinite(dD) & np.isfinite(dK), axis=(1, 2))[:, None]
+    fine &= np.all(np.isfinite(M) & np.isfinite(D) & np.isfinite(K), axis=(1, 2))[:, None]
+    b_all, j_all = np.nonzero(fine)
+    for s in range(0, len(b_all), chunk):
+        b, j = b_all[s:s + chunk], j_all[s:s + chunk]
+        l = lam[b, j][:, None, None]
+        U, _, Vh = np.linalg.svd(M[b] * l**2 + D[b] * l + K[b])
+        x, y = Vh[:, -1].conj(), U[:, :, -1]
+        al = np.abs(l)
+        scale = np.einsum("ki,kij,kj->k", np.abs(y), dM[b] * al**2 + dD[b] * al + dK[b], np.abs(x))
+        slope = np.abs(np.einsum("ki,kij,kj->k", y.conj(), 2 * M[b] * l + D[b], x)) * np.maximum(al[:, 0, 0], 1e-300)
+        with np.errstate(divide="ignore", invalid="ignore"):  # no change moves nothing (a zero root of a zero block)
+            out[b, j] = np.where(scale == 0, 0.0, np.where(slope > 0, scale / slope, np.inf))
+    return out
+
+
 def moved(p, rel):
     """Parameters (last axis; NumPy or a list of mpf) each moved by rel relative, with
     alternating signs: a fixed, reproducible perturbation of the inputs."""

@@ -3,7 +3,7 @@
 `derive.derivation.Derivation` they fill, with `ORDER` (its place in the derivation) and
 `ROUTES` (the routes it runs on: "coordinates", the equations in independent coordinates;
 "multipliers", holonomic constraints carried by Lagrange multipliers, chosen by the
-constraints pass). Each prints its steps with their times through `d.work.steps`.
+constraints pass; every pass takes both, tests/unit/test_passes.py). Each prints its steps with their times through `d.work.steps`.
 Discovered as the output kinds of derive/outputs/ are: adding a pass is adding a module.
 """
 from __future__ import annotations

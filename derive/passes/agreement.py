@@ -6,11 +6,11 @@ from derive.model import Model
 from derive.passes.operator import agree
 
 ORDER = 120
-ROUTES = ("coordinates",)
+ROUTES = ("coordinates", "multipliers")
 
 
 def run(model: Model, d):
-    if d.work.check.beside:
+    if d.work.check is not None and d.work.check.beside:
         with d.work.steps("the two routes agree: the check beside the steps above"):
             d.route_agreement = agree(d.work.check.result())
     return d

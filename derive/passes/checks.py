@@ -12,7 +12,7 @@ from derive.model import TIME, Model, Unsupported
 from derive.passes.conversion import refuse_nonholonomic
 
 ORDER = 40
-ROUTES = ("coordinates",)
+ROUTES = ("coordinates", "multipliers")
 
 UNBALANCE_HINT = ("write it as two force inputs (Signal('Fx', 'N', ..., input=True, order=0) and 'Fy', "
                   "with a Load on the rates of the rotor's centre) and use `gyro unbalance MODEL --force-x Fx "

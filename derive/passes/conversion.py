@@ -9,7 +9,7 @@ from derive import convert, names
 from derive.model import Model, Unsupported
 
 ORDER = 10
-ROUTES = ("coordinates",)
+ROUTES = ("coordinates", "multipliers")
 
 
 def refuse_nonholonomic(model: Model) -> None:

@@ -7,10 +7,10 @@ import dataclasses
 import sympy as sp
 
 from derive import nonsmooth
-from derive.model import Load, Model
+from derive.model import Load, Model, Unsupported
 
 ORDER = 30
-ROUTES = ("coordinates",)
+ROUTES = ("coordinates", "multipliers")
 
 
 def frozen(model: Model, kinks: nonsmooth.Kinks) -> Model:
@@ -28,4 +28,7 @@ def frozen(model: Model, kinks: nonsmooth.Kinks) -> Model:
 def run(model: Model, d):
     d.work.source, d.work.kinks = model, nonsmooth.Kinks()
     d.model = frozen(model, d.work.kinks)
+    if d.work.kinks.kinks and d.route == "multipliers":
+        raise Unsupported(f"{model.name}: non-smooth functions together with holonomic constraints "
+                          "that need multipliers")
     return d

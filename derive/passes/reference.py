@@ -1,15 +1,18 @@
 """The equations of the reference (rest, a relative equilibrium, or a declared steady
-motion) and their symmetric zeros; explicit time that no equilibrium absorbs is refused."""
+motion) and their symmetric zeros; explicit time that no equilibrium absorbs is refused. On
+the multipliers route, the forces at rest projected on the constraints, C' f0, in the
+independent coordinates (derive/constraints.py)."""
 from __future__ import annotations
 
 import sympy as sp
 
+from derive import constraints
 from derive import mechanics as mech
 from derive.model import TIME, Model, Unsupported
 from derive.passes.checks import UNBALANCE_HINT
 
 ORDER = 80
-ROUTES = ("coordinates",)
+ROUTES = ("coordinates", "multipliers")
 
 
 def refuse_time_forcing(model: Model, order, residual, even) -> None:
@@ -32,18 +35,28 @@ def refuse_time_forcing(model: Model, order, residual, even) -> None:
 
 
 def run(model: Model, d):
-    w, order = d.work, d.order
-    w.zero_set = {model.coordinate(c): 0 for c in list(model.symmetric_zero) + list(model.steady)}
+    w, order, held = d.work, d.order, d.work.held
+    symmetric = {model.coordinate(c): 0 for c in list(model.symmetric_zero) + list(model.steady)}
+    # on the multipliers route every coordinate stays an unknown of the reference (d.even)
+    w.zero_set = {} if held else symmetric
     w.Q0r = None if w.Q0 is None else [w.Q0[model.coordinates.index(c)] for c in order]
     reference = {v: d.rates.get(v, 0) for v in model.qd} | w.zero_set | w.zero_inputs
     w.reference = reference | {s: 0 for s in list(model.given_values) + list(model.given_derivatives)}
     with w.steps("equations of the reference and their symmetric zeros"):
-        residual = mech.equilibrium_equations(d.routhian, d.rq, d.rqd, at=w.zero_set, rates=d.rates, Q=w.Q0r,
-                                              signals=model.signals)
+        if held:  # the forces at rest projected on the constraints: C' f0 (derive/constraints.py)
+            held.C = constraints.projection(model, held)
+            held.rest = {v: 0 for v in model.qd} | {a: 0 for a in model.qdd} | w.zero_inputs
+            held.f0 = held.f.subs(held.rest)
+            residual = held.C.T * held.f0
+        else:
+            residual = mech.equilibrium_equations(d.routhian, d.rq, d.rqd, at=w.zero_set, rates=d.rates,
+                                                  Q=w.Q0r, signals=model.signals)
         if d.time_dependent:
             refuse_time_forcing(model, order, residual, d.even)
         for c in model.symmetric_zero:
-            r = sp.expand(residual[order.index(c)])
+            if c not in order:  # a dependent coordinate of the multipliers route: no row of its own
+                continue
+            r = sp.expand(residual[order.index(c)].xreplace(symmetric))
             if r != 0:
                 raise Unsupported(f"{model.name}: the equilibrium equation of {c} does not vanish on "
                                   f"the symmetric set: {r}")

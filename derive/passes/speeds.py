@@ -7,7 +7,7 @@ import sympy as sp
 from derive.model import TIME, Model
 
 ORDER = 140
-ROUTES = ("coordinates",)
+ROUTES = ("coordinates", "multipliers")
 
 
 def speeds_equations(model: Model, Mq: sp.Matrix, f: sp.Matrix) -> dict:

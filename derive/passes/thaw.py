@@ -8,7 +8,7 @@ from derive import mechanics as mech
 from derive.model import Model
 
 ORDER = 130
-ROUTES = ("coordinates",)
+ROUTES = ("coordinates", "multipliers")
 
 
 def run(model: Model, d):

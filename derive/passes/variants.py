@@ -10,7 +10,7 @@ from derive.derivation import VariantResult
 from derive.model import Model
 
 ORDER = 110
-ROUTES = ("coordinates",)
+ROUTES = ("coordinates", "multipliers")
 
 P_SYMBOL = sp.Symbol("p")  # the operator d/dt
 Z_SYMBOL = sp.Symbol("z")  # p^2

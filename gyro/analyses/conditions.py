@@ -352,12 +352,12 @@ def _point(model: Model, base: dict, axes: dict, options: dict, sets: dict) -> d
 
 def condition_map(model: Model, sets: dict, xaxis, yaxis, options: dict | None = None):
     """The condition's region, the spectrally stable one and the unstable one over a grid of
-    two axes ((name, lo, hi, n) each), the other parameters from `sets` (NAME=VALUE, over
+    two axes ((name, lo, hi, n) each), a condition Map, the other parameters from `sets` (NAME=VALUE, over
     the defaults). Values: 2 where the sufficient condition holds, 1 spectrally stable
     outside it, 0 unstable, -1 (BOUNDARY) where rounding could change the verdict, -2
     (MARGINAL) an exact zero root. Every grid point is checked first (ParameterError naming
     the point where a parameter is out of range or there is no equilibrium)."""
-    from gyro.results import ConditionMap
+    from gyro.results import Map
 
     options = dict(options or {})
     declared(model)
@@ -379,11 +379,13 @@ def condition_map(model: Model, sets: dict, xaxis, yaxis, options: dict | None =
     growth = np.where(label == "unstable", np.maximum(a["growth"], 0.0), 0.0).reshape(ny, nx)
     own = _hook(model, "condition_moved")
     moved = own(model, (xn, yn), options, sets) if own else {model.canonical(xn), model.canonical(yn)}
-    return ConditionMap(model=model.name, title=model.meta["title"], xname=model.canonical(xn),
-                        yname=model.canonical(yn), x=x, y=y, values=values.astype(int), growth=growth,
-                        orbit=bool(options.get("orbit", False)), condition=_name(model, options),
-                        boundary=(label == "boundary").reshape(ny, nx), reasons=a["verdict"].reason.reshape(ny, nx),
-                        base={k: float(v) for k, v in base.items() if k not in moved})
+    shape = (ny, nx)
+    layers = {"growth": growth, "boundary": (label == "boundary").reshape(shape),
+              "reasons": a["verdict"].reason.reshape(shape)}
+    info = {"condition": _name(model, options), "orbit": bool(options.get("orbit", False)),
+            "base": {k: float(v) for k, v in base.items() if k not in moved}}
+    return Map("condition", model.name, model.meta["title"], model.canonical(xn), model.canonical(yn), x, y,
+               values.astype(int), layers, info=info)
 
 
 def check_axes(model: Model, xaxis, yaxis, options: dict, sets: dict) -> None:

@@ -220,6 +220,8 @@ def unbalance_response(model: Model, values: dict, force_x: str, force_y: str, m
     unit = next(p.unit for p in model.params if p.name == spin)
     out = HarmonicResponse.concat(parts)
     out.x, out.xname, out.xunit = xs, spin, unit
+    out.heading = (f"unbalance m e = {magnitude:g} kg m on {force_x}, {force_y}; peak amplitudes |X|, "
+                   "x(t) = Re(X e^(i W t))")
     return out
 
 

@@ -51,12 +51,12 @@ def question_of(model, level: str, against: str, question: str | None = None) ->
 
 def level_map(model, level: str, against: str, xaxis, yaxis, sets: dict, tol: float,
               question: str | None = None, opts: dict | None = None, progress: bool = False):
-    """LevelMap: the error of `level` against `against` at every point of the grid
+    """An error Map: the error of `level` against `against` at every point of the grid
     (xaxis, yaxis: (name, lo, hi, n)), the other parameters from `sets` (model names,
     values checked: ParameterError naming the point); NaN where either level could not
     answer (then `failed` says so)."""
     from gyro.analyses.scene import level_error
-    from gyro.results import LevelMap
+    from gyro.results import Map
 
     q = question_of(model, level, against, question)
     if not (math.isfinite(tol) and 0 < tol < 1):
@@ -99,6 +99,7 @@ def level_map(model, level: str, against: str, xaxis, yaxis, sets: dict, tol: fl
     changed = {k: float(v) for k, v in sets.items() if float(v) != defaults.get(k)}
     units = {p.name: p.unit for p in model.params}
     measure = f"largest relative error of the {q} question over its quantities ({', '.join(questions.get(q).quantities(model, opts or {}))})"
-    return LevelMap(model.name, hierarchy.get(model, level).name, hierarchy.get(model, against).name,
-                    xaxis[0], yaxis[0], xs, ys, values, float(tol), measure, units, changed, failed,
-                    time.perf_counter() - c0)
+    info = {"level": hierarchy.get(model, level).name, "against": hierarchy.get(model, against).name,
+            "tol": float(tol), "measure": measure, "changed": changed, "failed": failed,
+            "seconds": time.perf_counter() - c0}
+    return Map("error", model.name, model.meta["title"], xaxis[0], yaxis[0], xs, ys, values, units=units, info=info)

@@ -137,8 +137,6 @@ def _inputs(model):
 
 def simulate(model, values: dict, offsets: dict, t: np.ndarray, method: str = "DOP853",
              budget_s: float = BUDGET_S):
-    from gyro.results.trajectory import CoordinateMotion
-
     if method not in METHODS:
         raise ParameterError(f"--method: unknown method {method!r}; known: {' '.join(METHODS)}")
     P = model.vector(values)
@@ -154,11 +152,37 @@ def simulate(model, values: dict, offsets: dict, t: np.ndarray, method: str = "D
     if not np.all(np.isfinite(Y)):
         raise FloatingPointError("a coordinate is not finite along the motion")
     n = len(model.meta["coordinates"])
-    units = model.meta.get("coordinate_units", {})
-    return CoordinateMotion(model=model.name, title=model.meta.get("title", model.name), method=method, t=np.asarray(t),
-                  coordinates=list(model.meta["coordinates"]), units=[units.get(c, "") for c in model.meta["coordinates"]],
-                  q=Y[:, :n].copy(), qd=Y[:, n:].copy(), params=dict(values), perturb=dict(offsets),
-                  equilibrium=st.equilibrium, seconds=time.perf_counter() - t0)
+    return coordinate_motion(model, method, t, Y[:, :n], Y[:, n:], dict(values), dict(offsets), st.equilibrium,
+                             time.perf_counter() - t0)
+
+
+# the generic motion's document: these keys, then each coordinate not among them
+HEAD = ["model", "method", "params", "perturb", "equilibrium", "coordinates", "units", "t", "rates", "seconds"]
+
+
+def coordinate_motion(model, method: str, t, q, qd, params: dict, perturb: dict, equilibrium: dict,
+                      seconds: float = 0.0):
+    """A motion of any model in its coordinates, as gyro.results.Motion: q and qd (times,
+    coordinates) absolute values in the model's units, the series the coordinates and their
+    rates NAME_d; the `gyro simulate --json` document of the generic motion: `t`, one list
+    per coordinate under its name, `method`, and `rates` ({NAME_d: list}), `coordinates`,
+    `units`, `params`, `perturb`, `equilibrium`, `model`, `seconds` (a model file's motion
+    of its own may give its own in the same form: tests/models/oscillator_own_motion.py)."""
+    from gyro.results import Motion
+
+    coords = list(model.meta["coordinates"])
+    units = [model.meta.get("coordinate_units", {}).get(c, "") for c in coords]
+    rates = [f"{c}_d" for c in coords]
+    title = model.meta.get("title", model.name)
+    heading = (f"{title} ({model.name}), method {method}, from the reference"
+               + (" with " + ", ".join(f"{k} {v:+g}" for k, v in perturb.items()) if perturb else ""))
+    info = {"params": params, "perturb": perturb, "equilibrium": equilibrium, "coordinates": coords,
+            "units": dict(zip(coords, units)), "seconds": seconds}
+    return Motion(model.name, title, method, np.asarray(t), coords + rates, np.hstack([q, qd]),
+                  units + [f"{u}/s" if u else "1/s" for u in units],
+                  [f"the coordinate {c}" for c in coords] + [f"the rate of {c}" for c in coords], info=info,
+                  keys=HEAD + [c for c in coords if c not in HEAD], groups={"rates": rates}, heading=[heading],
+                  shown=coords, formats={"t": ">12.6g", **{c: ">16.9g" for c in coords}}, gap="")
 
 
 # ----------------------------------------------------------------------------- the reduced state

@@ -55,7 +55,7 @@ def select(model, question: str, P, tol: float, opts: dict | None = None, among:
     for lv in cands:
         if pending.size == 0:
             break
-        trial = Trial(lv.name, np.zeros(N, np.int8), np.full(N, np.nan))
+        trial = Trial(lv.name, np.zeros(N, np.int8), np.full(N, np.nan), tol=tol)
         trials.append(trial)
         B = hierarchy.bounds(model, lv, question, P[pending], nq)
         missing = [names[j] for j in idx if not B.answered[j]]

@@ -90,5 +90,5 @@ def run(args) -> int:
     else:
         print(diagram.summary(out))
         if ks:
-            print(diagram.crossings_table())
+            print(diagram.table())
     return 0

@@ -1,6 +1,6 @@
 """`gyro stability-map MODEL --x NAME=LO:HI[:N] --y NAME=LO:HI[:N] [--x-log] [--y-log] --out
 FILE.png [--json]` (each axis also as `--x NAME --x-range LO HI`, as before): the figure, and with --json the document of
-gyro.results.StabilityMap.to_dict (keys x, y as `gyro map`, values: the class per point,
+gyro.results.Map.to_dict of a verdict map (keys x, y as `gyro map`, values: the class per point,
 boundary: where rounding could change the verdict) instead of the summary line."""
 from __future__ import annotations
 

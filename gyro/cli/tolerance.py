@@ -102,7 +102,7 @@ def run(args) -> int:
     if out is not None:
         study.plot(out)
     if tornado is not None:
-        study.sensitivities.tornado(tornado, title=f"{model.meta['title']}: sensitivities at the nominal set")
+        study.sensitivities.plot(tornado, title=f"{model.meta['title']}: sensitivities at the nominal set")
     if args.json:
         print(json.dumps(study.to_dict(), allow_nan=False))
     else:

@@ -40,7 +40,6 @@ def run(args) -> int:
     from gyro.analyses.spin import spin_parameter
     from gyro.errors import ParameterError
     from gyro.models import load
-    from gyro.results._io import cell
 
     model = load(args.model)
     require_inputs(model)
@@ -65,17 +64,7 @@ def run(args) -> int:
     if args.json:
         print(json.dumps(result.to_dict(), allow_nan=False))
     else:
-        amp = result.amplitudes
-        print(f"{result.title} ({result.model}): unbalance m e = {args.magnitude:g} kg m on "
-              f"{args.force_x}, {args.force_y}; peak amplitudes |X|, x(t) = Re(X e^(i W t))")
-        print(f"{'':>4} {spin:>12} {'W [rad/s]':>12} " + " ".join(f"{c + ' [' + u + ']':>14}"
-                                                               for c, u in zip(result.coordinates, result.units)))
-        rows = range(len(result)) if len(result) <= 21 else np.unique(np.linspace(0, len(result) - 1, 11).round().astype(int))
-        for i in rows:
-            cells = ["resonance" if result.resonance[i] else cell(a, ".6g") for a in amp[i]]
-            print(f"{i + 1:>4} {result.x[i]:>12.6g} {cell(result.omega[i], '>12.6g')} " + " ".join(f"{c:>14}" for c in cells))
-        if len(result) > 21:
-            print(f"({len(result)} points; 11 shown; --json prints all)")
+        print(result.table())
         if out is not None:
             print(result.summary(out))
     if bad.any():

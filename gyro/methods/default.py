@@ -38,6 +38,7 @@ def solve(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
     N = P.shape[0]
     qe, ok = equilibria(model, P)
     M, D, K = operators(model, P, qe)
+    moves = qep.equilibrium_moves(model, P, qe, M, D, K)  # the equilibrium's own rounding
     n = M.shape[-1]
     freq = np.full((N, n), np.nan)
     growth = np.zeros((N, n))
@@ -56,6 +57,7 @@ def solve(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
         take = slice(None) if h.size == N else h
         Mh, Dh, Kh = M[take], D[take], K[take]
         w, z, e, fine = qep.rayleigh(model, Mh, Dh, Kh, w0, z0, 3, tol, overwrite=True)  # the starts' own arrays
+        e = e + qep.hermitian_moves(tuple(X[take] for X in moves), Mh, Dh, w, z)
         ws_sorted = np.sort(w, axis=1)
         distinct = np.all(np.diff(ws_sorted, axis=1) > 1e-8 * ws_sorted[:, 1:], axis=1)
         # a root far below the others (omega1 -> 0 toward the pole or as u -> 0) carries the
@@ -72,6 +74,8 @@ def solve(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
         route[k] = "general"
         roots, e = qep.general(M[k], D[k], K[k])
         e = e + qep.input_rounding(model, P[k], roots, lambda Pp: qep.general_at(model, Pp))
+        e = e + qep.general_moves(tuple(X[k:k + 1] for X in moves), M[k:k + 1], D[k:k + 1], K[k:k + 1],
+                                  roots[None])[0]
         freq[k], growth[k], est[k] = np.abs(roots.imag), roots.real, e
         # an exact zero root (omega1 without Earth rate, u = 0: a free azimuth). lambda = 0 is
         # a root exactly when K is singular; where K is singular in double precision to the

@@ -56,11 +56,17 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None) -> Spectrum:
         # |ds| <= sum_j |dc_j| |s|^j / |c'(s)|
         conv = np.abs(np.array([to_s(np.eye(n + 1)[j]) for j in range(n + 1)]))  # (cheb, power)
         dc = qep.EPS * (n + 1) * np.max(np.abs(dets[k])) * conv.sum(axis=0)
-        ds = np.polynomial.polynomial.polyval(np.abs(roots_s), dc) / np.abs(
-            np.polynomial.polynomial.polyval(roots_s, np.polynomial.polynomial.polyder(c)))
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # inf or nan: no bound
+            ds = np.polynomial.polynomial.polyval(np.abs(roots_s), dc) / np.abs(
+                np.polynomial.polynomial.polyval(roots_s, np.polynomial.polynomial.polyder(c)))
+            e = 0.5 * ds / np.maximum(np.abs(roots_s), 1e-300)
         freq[k], growth[k] = np.abs(lam.imag), lam.real
-        e = 0.5 * ds / np.maximum(np.abs(roots_s), 1e-300)
         est[k] = np.where(e < 0.5, e, np.inf)  # a first-order bound past 1/2 bounds nothing
+    # the equilibrium's own rounding (gyro.qep.equilibrium_moves), where a root was found
+    done = np.flatnonzero(ok & np.any(np.isfinite(est), axis=1))
+    if done.size:
+        moves = qep.equilibrium_moves(model, P[done], qe[done], M[done], D[done], K[done])
+        est[done] += qep.general_moves(moves, M[done], D[done], K[done], growth[done] + 1j * freq[done])
     f, g, e = qep.sort_spectrum(freq, growth, est)
     return Spectrum("polyroots", f, g, e, qe)
 

@@ -21,17 +21,24 @@ def _mp_equilibrium(mf, p, q0, idx, max_iter=60):
     """Newton in the working precision from q0. Converged where every step is within tol of
     its coordinate, or, for a coordinate far smaller than the others (the gyrohorizoncompass's
     beta = 5e-20 at (3.1), where its steps stay at the rounding of the others' residual),
-    where the largest step is within tol of the largest coordinate and no longer shrinks."""
+    where the largest step is within tol of the largest coordinate and no longer shrinks.
+    idx None: a model with multipliers, whose equilibrium has every coordinate as unknown
+    and its own square system (the reduced residual and the constraints, the emitted
+    equilibrium_system)."""
     q = [mpmath.mpf(v) for v in q0]
-    if not idx:  # no equilibrium coordinates (a rotor centred by its bearings): nothing to solve
+    if idx is not None and not idx:  # no equilibrium coordinates (a rotor centred by its bearings)
         return q
     tol = mpmath.mpf(10) ** (-mpmath.mp.dps + 5)
     last = None
     for _ in range(max_iter):
-        r = mf.equilibrium_residual(p, q)
-        _, _, K = mf.operator(p, q)
-        Kee = mpmath.matrix([[K[i, j] for j in idx] for i in idx])
-        dq = mpmath.lu_solve(Kee, mpmath.matrix([r[i] for i in idx]))
+        if idx is None:
+            r, Kee = mf.equilibrium_system(p, q)
+            dq = mpmath.lu_solve(Kee, r)
+        else:
+            r = mf.equilibrium_residual(p, q)
+            _, _, K = mf.operator(p, q)
+            Kee = mpmath.matrix([[K[i, j] for j in idx] for i in idx])
+            dq = mpmath.lu_solve(Kee, mpmath.matrix([r[i] for i in idx]))
         q = [qi + dqi for qi, dqi in zip(q, dq)]
         if all(abs(d) <= tol * max(abs(v), mpmath.mpf(10) ** -300) for d, v in zip(dq, q)):
             return q
@@ -90,7 +97,8 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None, dps: int = DPS)
     a set without one is refused in one line naming the equation's residual."""
     mf = model.mpmath
     reduced = model.meta["reduced"]
-    idx = [reduced.index(c) for c in model.meta["equilibrium_coordinates"]]
+    multipliers = bool(model.meta.get("constraints", {}).get("multipliers"))
+    idx = None if multipliers else [reduced.index(c) for c in model.meta["equilibrium_coordinates"]]
     N = P.shape[0]
     qe_d, ok, report = equilibria_reported(model, P)
     out = None
@@ -104,7 +112,7 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None, dps: int = DPS)
             n = len(roots)
             if out is None:
                 out = [np.full((N, n), np.nan), np.full((N, n), np.nan), np.full((N, n), np.inf),
-                       np.full((N, len(idx)), np.nan)]
+                       np.full((N, len(q)), np.nan)]
             lam = np.array([complex(r) for r in roots])
             est = np.maximum(np.array([float(x) for x in steps]), 10.0 ** (5 - dps))
 

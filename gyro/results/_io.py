@@ -3,15 +3,38 @@ from __future__ import annotations
 
 import json
 import os
+from contextlib import contextmanager
 from dataclasses import fields, is_dataclass
 from pathlib import Path
 
 import numpy as np
 
 class Result:
-    """What every result of a batch or a set offers beside its own to_dict, table and plot:
-    save(path), every field into one .npz written atomically, and load(path), the same
-    fields back (the one place of both; `_loaded` rebuilds what JSON cannot carry)."""
+    """The contract of every result in gyro.results:
+
+    - `save(path)`: every field into one .npz, written atomically (whole or not at all);
+      `load(path)` (a classmethod): the same result back, nested results (a sweep's
+      Spectrum, a tolerance study's Sensitivities, a Campbell diagram's crossings, a scene's
+      trials) rebuilt in their own types. ModalResult writes its JSON document instead (a
+      .json, as it always has).
+    - `to_dict()`: a JSON-ready document: the command's --json document where a command
+      prints the result (its keys are the contract), every field otherwise.
+    - `table()`: the text the command prints; a per-set result (Spectrum, Sensitivities,
+      Scene, ForcedResponse) takes the set `k` (default 0), and a Spectrum the model whose
+      names it prints.
+    - `plot(out)`: the figure into `out`, a file (PNG, written atomically) or matplotlib
+      axes (a figure for the results of several panels: Motion, CampbellDiagram,
+      ToleranceStudy, Sensitivities, HarmonicResponse, ForcedResponse).
+
+    Without a plot (`plot` raises NotImplementedError saying so; NO_PLOT the reason):
+    Verdict and Stability (a label per set: the figure of what holds them draws them, a
+    map or a Campbell diagram), Crossing (a point of its Campbell diagram), Trial and Scene
+    (the selector's bookkeeping, and an answer per set whose figure is its question's
+    result), ModalResult (one set's frequencies: `gyro frequencies` lists them) and
+    EquilibriumStability (one set's margins and eigenvalues: `gyro stability` lists them;
+    the condition Map draws the regions)."""
+
+    NO_PLOT = ""
 
     def save(self, path) -> None:
         _save_npz(self, path)
@@ -22,7 +45,18 @@ class Result:
 
     @classmethod
     def _loaded(cls, obj):
+        """What JSON cannot carry rebuilt after loading (object arrays, tuples)."""
         return obj
+
+    def to_dict(self) -> dict:
+        """Every field, JSON-ready (a result with a command's document overrides this)."""
+        return {f.name: _jsonable(getattr(self, f.name)) for f in fields(self)}
+
+    def table(self) -> str:
+        raise NotImplementedError(f"{type(self).__name__}: no table")
+
+    def plot(self, out):
+        raise NotImplementedError(f"{type(self).__name__} has no plot: {self.NO_PLOT}")
 
 
 def _save_npz(obj, path) -> None:
@@ -30,7 +64,7 @@ def _save_npz(obj, path) -> None:
     data = {}
     for f in fields(obj):
         v = getattr(obj, f.name)
-        if isinstance(v, np.ndarray) and v.dtype != object:
+        if isinstance(v, np.ndarray) and v.dtype != object and v.ndim > 0:
             data[f.name] = v
         else:
             data[f.name] = np.array(json.dumps(_jsonable(v)))
@@ -45,6 +79,18 @@ def _save_npz(obj, path) -> None:
         tmp.unlink(missing_ok=True)
 
 
+def _write_text(path, text: str) -> None:
+    """A text file written atomically: a temporary beside it, renamed."""
+    path = Path(path)
+    _clean_stale(path)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}{TMP_TAG}")
+    try:
+        tmp.write_text(text)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
 def _load_npz(cls, path):
     hints = _hints(cls)
     with np.load(path, allow_pickle=False) as z:
@@ -53,7 +99,9 @@ def _load_npz(cls, path):
             if f.name not in z:
                 continue
             v = z[f.name]
-            kw[f.name] = _rebuild(hints.get(f.name), json.loads(v.item())) if v.dtype.kind == "U" else v
+            # a field that is no array of numbers was saved as JSON, a 0-d string
+            json_ = v.dtype.kind == "U" and v.ndim == 0
+            kw[f.name] = _rebuild(hints.get(f.name), json.loads(v.item())) if json_ else v
     return cls(**kw)
 
 
@@ -84,7 +132,8 @@ def _rebuild(tp, value):
     if is_dataclass(tp) and isinstance(value, dict):
         hints = _hints(tp)
         names = {f.name for f in fields(tp)}
-        return tp(**{k: _rebuild(hints.get(k), v) for k, v in value.items() if k in names})
+        obj = tp(**{k: _rebuild(hints.get(k), v) for k, v in value.items() if k in names})
+        return tp._loaded(obj) if isinstance(obj, Result) else obj
     if tp is np.ndarray:
         if isinstance(value, dict) and set(value) == {"re", "im"}:
             return np.asarray(value["re"]) + 1j * np.asarray(value["im"])
@@ -100,6 +149,8 @@ def _jsonable(v):
         return v.tolist()
     if isinstance(v, (list, tuple)):
         return [_jsonable(x) for x in v]
+    if isinstance(v, dict):
+        return {k: _jsonable(x) for k, x in v.items()}
     if isinstance(v, (np.floating, np.integer)):
         return v.item()
     if is_dataclass(v) and not isinstance(v, type):
@@ -145,6 +196,37 @@ def save_figure(fig, out) -> None:
         tmp.unlink(missing_ok=True)
 
 
+@contextmanager
+def _canvas(out, **figkw):
+    """The figure a plot draws into: `out` a matplotlib Figure (drawn into and left open),
+    or a path (a new figure, written there whole or not at all, then closed)."""
+    from matplotlib.figure import Figure
+
+    if isinstance(out, Figure):
+        yield out
+        return
+    plt = _pyplot()
+    fig = plt.figure(**{"layout": "constrained", **figkw})
+    try:
+        yield fig
+        save_figure(fig, out)
+    finally:
+        plt.close(fig)
+
+
+@contextmanager
+def _axes(out, **figkw):
+    """The axes a one-panel plot draws into: `out` a matplotlib Axes, a Figure (a panel
+    added) or a path (as _canvas)."""
+    from matplotlib.axes import Axes
+
+    if isinstance(out, Axes):
+        yield out
+        return
+    with _canvas(out, **figkw) as fig:
+        yield fig.add_subplot()
+
+
 def _pyplot():
     import matplotlib
 
@@ -171,11 +253,34 @@ def _finite_or_none(a) -> list:
 
 
 
-def mode_panels(plt, n: int, height: float):
+def _subplots(out, *args, **kw):
+    """(figure, axes) of a plot of several panels into `out`: the panels added to a
+    matplotlib Figure given as `out`, or a new figure (for a file)."""
+    from matplotlib.figure import Figure
+
+    if isinstance(out, Figure):
+        kw.pop("figsize", None), kw.pop("layout", None)
+        return out, out.subplots(*args, **kw)
+    return _pyplot().subplots(*args, **kw)
+
+
+def _finish(fig, out) -> None:
+    """A new figure written to the file `out` whole or not at all, and closed; a Figure
+    given as `out` is left open to its owner."""
+    from matplotlib.figure import Figure
+
+    if not isinstance(out, Figure):
+        try:
+            save_figure(fig, out)
+        finally:
+            _pyplot().close(fig)
+
+
+def mode_panels(out, n: int, height: float):
     """A figure of n panels, one a mode, five to a row; unused panels hidden."""
     cols = min(n, 5)
     rows = -(-n // cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(3.1 * cols, height * rows), layout="constrained", squeeze=False)
+    fig, axes = _subplots(out, rows, cols, figsize=(3.1 * cols, height * rows), layout="constrained", squeeze=False)
     for ax in axes.flat[n:]:
         ax.axis("off")
     return fig, axes

@@ -5,14 +5,14 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from gyro.results._io import Result, _pyplot, save_figure
+from gyro.results._io import Result, _finish, _pyplot, _subplots
 from gyro.results.spectrum import Spectrum, Stability, classify, nearest_error
 
 FORMULA_BAD = 0.01  # a formula errs by more than 1 %: shaded in the Campbell diagram
 
 
 @dataclass(frozen=True)
-class Crossing:
+class Crossing(Result):
     """Where the harmonic line k x spin rate meets the damped frequency of a mode: a critical
     speed, at the swept parameter's `value` and `spin_rate` (rad/s); `frequency` =
     Im(lambda) there (rad/s). `mode` numbers the root as `gyro frequencies` does at that
@@ -25,6 +25,15 @@ class Crossing:
     spin_rate: float
     frequency: float
     branch: int = 0
+
+    NO_PLOT = "a point of its Campbell diagram, which draws it"
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    def table(self) -> str:
+        """Its row of the diagram's table of crossings."""
+        return f"{self.k:>3} {self.mode:>5} {self.value:>14.9g} {self.spin_rate:>18.9g} {self.frequency:>18.9g}"
 
 
 @dataclass
@@ -97,14 +106,13 @@ class CampbellDiagram(Result):
                 "growing": [[bool(b) for b in row] for row in self.growing()],
                 "mode_number": [[int(j) for j in self.numbers(i)] for i in range(len(self.Omega))]}
 
-    def crossings_table(self) -> str:
+    def table(self) -> str:
+        """The `gyro campbell` text after its summary line (with --harmonics): the critical
+        speeds, each mode numbered as `gyro frequencies` numbers it at the crossing's spin."""
         if not self.crossings:
             return f"no crossing of the lines {', '.join(f'{k}x' for k in self.harmonics)} with a mode in the sweep"
-        # mode: as `gyro frequencies` numbers it at the crossing's spin
         lines = [f"{'k':>3} {'mode':>5} {self.spin:>14} {'spin rate [rad/s]':>18} {'frequency [rad/s]':>18}"]
-        for c in self.crossings:
-            lines.append(f"{c.k:>3} {c.mode:>5} {c.value:>14.9g} {c.spin_rate:>18.9g} {c.frequency:>18.9g}")
-        return "\n".join(lines)
+        return "\n".join(lines + [c.table() for c in self.crossings])
 
     @property
     def formula_error(self) -> np.ndarray | None:
@@ -150,7 +158,7 @@ class CampbellDiagram(Result):
         plt = _pyplot()
         W = self.Omega
         panels = 2 if self.formulas is not None else 1
-        fig, axes = plt.subplots(panels, 1, figsize=(8, 9 if panels == 2 else 6), sharex=True,
+        fig, axes = _subplots(out, panels, 1, figsize=(8, 9 if panels == 2 else 6), sharex=True,
                                  layout="constrained", height_ratios=[3, 2][:panels], squeeze=False)
         ax = axes[0, 0]
         ex = self.exact.frequencies if self.tracked is None else self.tracked.frequencies
@@ -198,8 +206,7 @@ class CampbellDiagram(Result):
         ax.set_title(f"Campbell diagram: {self.title}{changed}", fontsize=10)
         ax.grid(True, which="both", alpha=0.25)
         ax.legend(fontsize=8, loc="upper left")
-        save_figure(fig, out)
-        plt.close(fig)
+        _finish(fig, out)
 
     def _unstable(self, ax, ex) -> None:
         """Growing branches drawn red and thick (a lone growing point as a red cross); the
@@ -268,7 +275,7 @@ class CampbellDiagram(Result):
                             edgecolors="none", label=f"{kind} whirl" if kind not in labelled else None)
             labelled.add(kind)
         if damped and sc is not None:
-            bar = plt.colorbar(sc, ax=ax, label="damping ratio zeta" + (" (< 0: the root grows)" if grows else ""),
+            bar = ax.figure.colorbar(sc, ax=ax, label="damping ratio zeta" + (" (< 0: the root grows)" if grows else ""),
                                shrink=0.8)
             if norm is not None:  # ticks on both sides of zero (each side has half the bar)
                 bar.set_ticks(np.unique(np.r_[np.linspace(norm.vmin, 0, 3), np.linspace(0, norm.vmax, 4)]))

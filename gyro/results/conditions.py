@@ -1,13 +1,13 @@
 """The stability of an equilibrium by any model's declared sufficient conditions against its
-spectrum (gyro/analyses/conditions.py): one set's verdict, and the map of the regions over
-two parameters."""
+spectrum (gyro/analyses/conditions.py): one set's verdict (the map of the regions over two
+parameters is a condition Map, gyro/results/map.py)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from gyro.results._io import Result, _edges, _pyplot, save_figure
+from gyro.results._io import Result
 
 
 @dataclass
@@ -38,6 +38,9 @@ class EquilibriumStability(Result):
     extra: dict = field(default_factory=dict)
     lines: list = field(default_factory=list)
     condition: str = ""
+
+    NO_PLOT = ("one set's margins and eigenvalues: `gyro stability` lists them (the condition Map draws the "
+               "regions over two parameters)")
 
     @property
     def boundary(self) -> bool:
@@ -91,96 +94,3 @@ class EquilibriumStability(Result):
         s.eigenvalues = np.asarray(s.eigenvalues, float)
         s.radii = None if s.radii is None else np.asarray(s.radii, float)
         return s
-
-
-@dataclass
-class ConditionMap(Result):
-    """Over a grid of two axes (arrays (y, x)): 2 where the sufficient condition (the model's
-    declared one, gyro/analyses/conditions.py) holds, 1 where the linearisation is spectrally stable outside it
-    (gyroscopic stabilisation), 0 where it is unstable."""
-
-    model: str
-    title: str
-    xname: str
-    yname: str
-    x: np.ndarray
-    y: np.ndarray
-    values: np.ndarray  # (y, x) int: 2, 1, 0, BOUNDARY (-1), MARGINAL (-2)
-    growth: np.ndarray  # (y, x) largest real part, 1/s, of a certainly unstable point (0 elsewhere)
-    orbit: bool = False
-    base: dict = field(default_factory=dict)  # the other parameters (declared names)
-    boundary: np.ndarray | None = None  # (y, x) bool: rounding could change the verdict
-    reasons: np.ndarray | None = None  # (y, x) object: why a point is a boundary (None elsewhere)
-    condition: str = ""  # the sufficient condition's name ("(3.6)", "(4.3)" the gyrohorizoncompass's)
-
-    KIND = ("2: {c} holds, 1: spectrally stable outside {c}, 0: unstable, -1: boundary (rounding "
-            "could change the verdict), -2: marginal (an exact zero root)")
-    BOUNDARY, MARGINAL = -1, -2
-
-    def __post_init__(self):
-        if self.boundary is None:
-            self.boundary = np.asarray(self.values) == self.BOUNDARY
-        self.boundary = np.asarray(self.boundary, bool)
-
-    @property
-    def kind(self) -> str:
-        return self.KIND.format(c=self.condition)
-
-    def counts(self) -> dict:
-        """Points per class; a boundary point counts as none of the others (never stable,
-        never stabilised)."""
-        v = np.asarray(self.values)
-        out = {"sufficient": int(np.sum(v == 2)), "gyroscopic": int(np.sum(v == 1)), "unstable": int(np.sum(v == 0)),
-               "boundary": int(np.sum(v == self.BOUNDARY))}
-        if np.any(v == self.MARGINAL):
-            out["marginal"] = int(np.sum(v == self.MARGINAL))
-        return out
-
-    def to_dict(self) -> dict:
-        """The `gyro map --json` document (its keys are the contract)."""
-        return {"x": {"name": self.xname, "values": np.asarray(self.x).tolist()},
-                "y": {"name": self.yname, "values": np.asarray(self.y).tolist()},
-                "values": np.asarray(self.values).astype(int).tolist(), "kind": self.kind,
-                "boundary": np.asarray(self.boundary, bool).tolist()}
-
-    def summary(self, out) -> str:
-        c = self.counts()
-        which = self.condition
-        extra = f", {c['marginal']} marginal" if "marginal" in c else ""
-        return (f"gyro: wrote {out} ({self.values.size} points: {c['sufficient']} where {which} holds, "
-                f"{c['gyroscopic']} spectrally stable outside it, {c['unstable']} unstable, "
-                f"{c['boundary']} within rounding of a boundary{extra})")
-
-
-    @classmethod
-    def _loaded(cls, m) -> "ConditionMap":
-        m.values = np.asarray(m.values, int)
-        m.boundary = np.asarray(m.boundary, bool)
-        m.reasons = None if m.reasons is None else np.array(m.reasons, dtype=object)
-        return m
-
-    def plot(self, out) -> None:
-        plt = _pyplot()
-        from matplotlib.colors import ListedColormap
-
-        which = self.condition
-        colors = ["#7a6fb0", "#222222", "#f2b8b0", "#f3e3a1", "#cfe8cf"]  # codes -2 .. 2
-        names = {2: f"{which} holds", 1: f"spectrally stable outside {which} (gyroscopic stabilisation)",
-                 0: "unstable", -1: "boundary: rounding could change the verdict",
-                 -2: "marginal: an exact zero root"}
-        fig, ax = plt.subplots(figsize=(7.5, 5.8), layout="constrained")
-        ax.pcolormesh(_edges(np.asarray(self.x), False), _edges(np.asarray(self.y), False), self.values,
-                      cmap=ListedColormap(colors), vmin=-2.5, vmax=2.5, shading="flat")
-        for code in (2, 1, 0, -1, -2):
-            if np.any(self.values == code):
-                ax.fill_between([], [], color=colors[code + 2],
-                                label=f"{names[code]}: {int(np.sum(self.values == code))}")
-        ax.set_xlim(_edges(np.asarray(self.x), False)[[0, -1]])
-        ax.set_ylim(_edges(np.asarray(self.y), False)[[0, -1]])
-        ax.set_xlabel(self.xname)
-        ax.set_ylabel(self.yname)
-        fixed = ", ".join(f"{k} = {v:.3g}" for k, v in self.base.items() if k not in ("theta", "chi"))
-        ax.set_title(f"{self.title}: {which} against the spectrum\n({fixed})", fontsize=8)
-        ax.legend(fontsize=8, loc="best")
-        save_figure(fig, out)
-        plt.close(fig)

@@ -8,7 +8,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from gyro.results._io import Result, _finite_or_none, _pyplot, save_figure
+from gyro.results._io import Result, _finish, _finite_or_none, _more_rows, _shown_rows, _subplots, cell
 
 
 class _Amplitudes:
@@ -53,9 +53,24 @@ class HarmonicResponse(_Amplitudes, Result):
     x: np.ndarray  # (sets,) the swept axis (omega unless a parameter was swept)
     xname: str = "omega"
     xunit: str = "rad/s"
+    # what the inputs are, after the title in the table (an unbalance: its m e and inputs)
+    heading: str = "steady response to harmonic inputs; peak amplitudes |X|, x(t) = Re(X e^(i W t))"
 
     def __len__(self) -> int:
         return self.X.shape[0]
+
+    def table(self) -> str:
+        """The `gyro unbalance` text: per value of the swept axis, the rate W and each
+        coordinate's peak amplitude (up to 21 rows, else 11 spread evenly)."""
+        amp = self.amplitudes
+        lines = [f"{self.title} ({self.model}): {self.heading}",
+                 f"{'':>4} {self.xname:>12} {'W [rad/s]':>12} " + " ".join(f"{c + ' [' + u + ']':>14}"
+                                                                         for c, u in zip(self.coordinates, self.units))]
+        for i in _shown_rows(len(self)):
+            cells = ["resonance" if self.resonance[i] else cell(a, ".6g") for a in amp[i]]
+            lines.append(f"{i + 1:>4} {self.x[i]:>12.6g} {cell(self.omega[i], '>12.6g')} "
+                         + " ".join(f"{c:>14}" for c in cells))
+        return "\n".join(lines + _more_rows(len(self)))
 
     @classmethod
     def concat(cls, parts: list["HarmonicResponse"]) -> "HarmonicResponse":
@@ -88,14 +103,13 @@ class HarmonicResponse(_Amplitudes, Result):
     def plot(self, out, coordinates=None) -> None:
         """Bode figure: amplitude (log) and phase of the chosen coordinates (default: those
         with the largest response) against the swept axis; resonances as vertical lines."""
-        plt = _pyplot()
         amp = self.amplitudes
         if coordinates is None:
             peak = np.nanmax(np.where(np.isfinite(amp), amp, np.nan), axis=0, initial=0.0)
             rel = {"m": 1.0, "rad": 1.0}
             order = np.argsort(-np.nan_to_num(peak * [rel.get(u, 1.0) for u in self.units]))
             coordinates = [self.coordinates[i] for i in order[:4] if np.nan_to_num(peak[i]) > 0]
-        fig, (a1, a2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True, layout="constrained")
+        fig, (a1, a2) = _subplots(out, 2, 1, figsize=(8, 7), sharex=True, layout="constrained")
         for c in coordinates:
             i = self.coordinates.index(c)
             a1.semilogy(self.x, np.where(np.isfinite(amp[:, i]), amp[:, i], np.nan), label=f"{c} [{self.units[i]}]")
@@ -110,8 +124,7 @@ class HarmonicResponse(_Amplitudes, Result):
         a1.legend(fontsize=8)
         for ax in (a1, a2):
             ax.grid(True, which="both", alpha=0.25)
-        save_figure(fig, out)
-        plt.close(fig)
+        _finish(fig, out)
 
 
 @dataclass
@@ -216,8 +229,7 @@ class ForcedResponse(_Amplitudes, Result):
     def plot(self, out, k: int = 0) -> None:
         """Amplitude spectrum: each harmonic's peak amplitude per coordinate (stems at k
         omega_c, translations and angles on two axes), the natural frequencies marked."""
-        plt = _pyplot()
-        fig, axes = plt.subplots(2, 1, figsize=(8, 7), sharex=True, layout="constrained")
+        fig, axes = _subplots(out, 2, 1, figsize=(8, 7), sharex=True, layout="constrained")
         wmax = max(np.nanmax(self.frequency[k]), np.nanmax(self.natural[k])) * 1.08
         for ax, unit in zip(axes, ("m", "rad")):
             cols = [i for i, u in enumerate(self.units) if u == unit]
@@ -243,7 +255,6 @@ class ForcedResponse(_Amplitudes, Result):
         axes[1].set_xlim(0, wmax)
         axes[1].set_xlabel("frequency k omega_c [rad/s] (dotted: natural frequencies; red: resonance)")
         axes[0].set_title(f"Amplitude spectrum of the response to {self.label}: {self.title}", fontsize=10)
-        save_figure(fig, out)
-        plt.close(fig)
+        _finish(fig, out)
 
 

@@ -4,9 +4,11 @@ a value per set and level tried), the reasons' text is made only for the sets sh
 that a million sets cost the selector little beside its levels."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
+
+from gyro.results._io import Result
 
 
 # why a level was or was not enough for a set: the code of Trial.code
@@ -14,7 +16,7 @@ NOT_REACHED, NOT_ANSWERED, EDGE, APRIORI, FAILED, QUESTION_EDGE, BOUND, ACCEPTED
 
 
 @dataclass
-class Trial:
+class Trial(Result):
     """One level tried on the sets still open: per set, its code, the bound concerned, and
     the text of an edge or failure (None where there is none)."""
 
@@ -23,6 +25,27 @@ class Trial:
     value: np.ndarray  # (sets,) the a-priori part or the whole bound
     text: np.ndarray | None = None  # object (sets,): edge name, failure, question edge
     missing: str = ""  # the requested quantities the level does not answer
+    tol: float = float("nan")  # the tolerance it was tried at (its reasons' right-hand side)
+
+    NO_PLOT = "the selector's bookkeeping of one level: `gyro scene` lists it as the levels tried"
+
+    def to_dict(self) -> dict:
+        """The level, and per set the reason it was or was not enough (null: not reached);
+        refused for a trial without its tolerance (its reasons compare with it)."""
+        if not np.isfinite(self.tol):
+            raise ValueError(f"Trial {self.level}: no tolerance recorded, which its reasons compare with")
+        return {"level": self.level, "reasons": [self.reason(k, self.tol) for k in range(len(self.code))]}
+
+    def table(self) -> str:
+        return "\n".join(f"{self.level}, set {k + 1}: {r}" for k, r in enumerate(self.to_dict()["reasons"])
+                         if r is not None)
+
+    @classmethod
+    def _loaded(cls, t) -> "Trial":
+        t.code = np.asarray(t.code, np.int8)
+        t.value = np.asarray(t.value, float)
+        t.text = None if t.text is None else np.array(t.text, dtype=object)
+        return t
 
     def say(self, sets: np.ndarray, texts: np.ndarray) -> None:
         """The text of an edge or failure at these sets (the array made at the first)."""
@@ -48,7 +71,7 @@ class Trial:
 
 
 @dataclass
-class Scene:
+class Scene(Result):
     """Per set k: `level[k]` the level that answered ('' where none could), `bound[k]` its
     relative bound per requested quantity, `tried(k)` the levels tried cheapest first,
     each (level, reason), `document(k)` the question's own keys; `best(k)` the smallest
@@ -60,10 +83,29 @@ class Scene:
     quantities: list
     level: np.ndarray
     bound: np.ndarray  # (sets, requested quantities)
-    trials: list
+    trials: list[Trial]
     seconds: float
     answers: dict = field(default_factory=dict)  # level -> (question module, model, Answer, idx)
     row: np.ndarray | None = None  # per set: its row in its level's answer
+    # a loaded scene's answers: per set its question's document, and per level the key of
+    # its per-quantity values (the question's VALUES), as `save` wrote them
+    documents: list | None = None
+    values_keys: dict = field(default_factory=dict)
+
+    NO_PLOT = "an answer per set and the levels tried: the figure of an answer is its question's result"
+
+    def save(self, path) -> None:
+        """Every field, the answers as the documents of every set (and the key of their
+        values) rather than the levels' objects: what to_dict and table print, loaded."""
+        docs = [self.document(k) for k in range(len(self))]
+        keys = {lv: getattr(a[0], "VALUES", None) for lv, a in self.answers.items()} or self.values_keys
+        super(Scene, replace(self, answers={}, documents=docs, values_keys=keys)).save(path)
+
+    @classmethod
+    def _loaded(cls, s) -> "Scene":
+        s.level = np.asarray(s.level, dtype=str)
+        s.bound = np.asarray(s.bound, float)
+        return s
 
     def __len__(self) -> int:
         return len(self.level)
@@ -85,10 +127,12 @@ class Scene:
     def document(self, k: int) -> dict:
         if not self.level[k]:
             return {}
+        if self.documents is not None and self.level[k] not in self.answers:
+            return self.documents[k]
         q, model, ans, idx = self.answers[self.level[k]]
         return q.document(model, ans, int(self.row[k]), idx)
 
-    def to_dict(self, k: int) -> dict:
+    def to_dict(self, k: int = 0) -> dict:
         """The `gyro scene --json` document of set k (its keys are the contract)."""
         out = {"model": self.model, "question": self.question, "tol": self.tol, "level": str(self.level[k]),
                "tried": [{"level": lv, "reason": r} for lv, r in self.tried(k)]}
@@ -98,13 +142,15 @@ class Scene:
         out["seconds"] = self.seconds
         return out
 
-    def table(self, k: int) -> str:
+    def table(self, k: int = 0) -> str:
         d = self.to_dict(k)
         lines = [f"{self.model}: {self.question} to a relative {self.tol:g}: level {d['level']}",
                  "levels tried, cheapest first:"]
         lines += [f"  {t['level']:<24} {t['reason']}" for t in d["tried"]]
         # the per-quantity answer where the question names one (its module's VALUES key)
-        vkey = getattr(self.answers[self.level[k]][0], "VALUES", None) if self.level[k] else None
+        level = self.level[k]
+        vkey = (None if not level else getattr(self.answers[level][0], "VALUES", None) if level in self.answers
+                else self.values_keys.get(level))
         values = d.get(vkey) if vkey else None
         lines.append(f"{'quantity':>12} {'value':>22} {'bound':>10}")
         for j, name in enumerate(self.quantities):

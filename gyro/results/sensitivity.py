@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gyro.results._io import Result, _pyplot, mode_panels, save_figure
+from gyro.results._io import Result, _finish, mode_panels
 from gyro.results.spectrum import Spectrum
 
 
@@ -32,14 +32,14 @@ class Sensitivities(Result):
         with np.errstate(all="ignore"):
             return self.d * self.params[:, None, :] / self.spectrum.frequencies[:, :, None]
 
-    def to_dict(self, k: int) -> dict:
+    def to_dict(self, k: int = 0) -> dict:
         """The keys `gyro frequencies --sensitivities` adds to its JSON (set k): for each
         frequency a list over the parameters in `gyro params` order, null for a double root."""
         return {"sensitivities": _numbers(self.d[k]), "relative_sensitivities": _numbers(self.relative[k]),
                 "sensitivity_parameters": list(self.param_names),
                 "double_root": [bool(b) for b in self.double[k]]}
 
-    def table(self, k: int, top: int = 3) -> str:
+    def table(self, k: int = 0, top: int = 3) -> str:
         """Per frequency, the parameters that move it most (relative sensitivity)."""
         rel = self.relative[k]
         lines = ["relative sensitivities (p/omega) d omega/d p, the largest three per frequency:"]
@@ -56,13 +56,12 @@ class Sensitivities(Result):
             lines.append(f"{i:>4}   " + "   ".join(f"{self.param_names[j]:>6} {row[j]:+.4f}" for j in order))
         return "\n".join(lines)
 
-    def tornado(self, out, k: int = 0, modes=None, top: int = 8, title: str = "") -> None:
+    def plot(self, out, k: int = 0, modes=None, top: int = 8, title: str = "") -> None:
         """A tornado chart of set k: per frequency, the relative sensitivities of the `top`
-        parameters that move it most, largest at the top."""
-        plt = _pyplot()
+        parameters that move it most, largest at the top (into a file or a Figure)."""
         rel = self.relative[k]
         modes = list(range(rel.shape[0])) if modes is None else list(modes)
-        fig, axes = mode_panels(plt, len(modes), 2.6)
+        fig, axes = mode_panels(out, len(modes), 2.6)
         for ax, i in zip(axes.flat, modes):
             w = self.spectrum.frequencies[k, i]
             ax.set_title(f"omega{i + 1} = {w:.5g} rad/s", fontsize=9)
@@ -81,6 +80,5 @@ class Sensitivities(Result):
         fig.supxlabel("relative sensitivity (p / omega) d omega / d p", fontsize=9)
         if title:
             fig.suptitle(title, fontsize=10)
-        save_figure(fig, out)
-        plt.close(fig)
+        _finish(fig, out)
 

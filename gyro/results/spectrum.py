@@ -8,7 +8,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from gyro.results import verdict
-from gyro.results._io import Result, _pyplot, cell
+from gyro.results._io import Result, _axes, _finite_or_none, _pyplot, _write_text, cell
 
 
 @dataclass
@@ -67,8 +67,15 @@ class Spectrum(Result):
                for f in ("frequencies", "growth", "error_estimate", "equilibrium", "route", "modes", "steady")}
         return cls(parts[0].method, **cat, growth_known=all(p.growth_known for p in parts))
 
-    def to_dict(self, k: int, model, params: dict) -> dict:
-        """The `gyro frequencies --json` document of set k (its keys are the contract)."""
+    def to_dict(self, k: int | None = None, model=None, params: dict | None = None) -> dict:
+        """The `gyro frequencies --json` document of set k (default 0; its keys are the
+        contract) where the model is given; without it, the whole batch: method, and per set
+        frequencies, eigenvalues_re, error_estimate, equilibrium, route, stability (the
+        verdict's label), null where a value is not finite."""
+        if model is None:
+            return self._batch_dict() if k is None else {key: v[k] if isinstance(v, list) else v
+                                                         for key, v in self._batch_dict().items()}
+        k = 0 if k is None else k
         stab = classify(self)
         eq = (None if self.equilibrium is None else
               dict(zip(model.meta["equilibrium_coordinates"], map(float, self.equilibrium[k]))))
@@ -86,6 +93,13 @@ class Spectrum(Result):
                           "reason": None if stab.reason is None else stab.reason[k]},
         } | (self.modes_dict(k, model) if self.modes is not None else {})
 
+    def _batch_dict(self) -> dict:
+        return {"method": self.method, "frequencies": _finite_or_none(self.frequencies),
+                "eigenvalues_re": _finite_or_none(self.growth), "error_estimate": _finite_or_none(self.error_estimate),
+                "equilibrium": None if self.equilibrium is None else _finite_or_none(self.equilibrium),
+                "route": None if self.route is None else [str(r) for r in self.route],
+                "stability": [str(c) for c in classify(self).label]}
+
     def modes_dict(self, k: int, model) -> dict:
         """`gyro frequencies --modes`: damping ratio, logarithmic decrement and one right
         eigenvector per frequency (coordinates in the `reduced` order, {re, im} lists)."""
@@ -94,13 +108,14 @@ class Spectrum(Result):
                 "coordinates": list(model.meta["reduced"]),
                 "modes": [{"re": num(v.real), "im": num(v.imag)} for v in self.modes[k]]}
 
-    def table(self, k: int, model) -> str:
-        """The `gyro frequencies` text of set k."""
+    def table(self, k: int = 0, model=None) -> str:
+        """The `gyro frequencies` text of set k (the model's title and name first where it
+        is given)."""
         freqs, est = self.frequencies[k], self.error_estimate[k]
         stab = classify(self)
         damped = self.damped  # a decaying root: the damping ratio and log. decrement shown
-        lines = [f"{model.meta['title']} ({model.name})",
-                 f"natural frequencies by the method '{self.method}'"
+        lines = [f"{model.meta['title']} ({model.name})"] if model is not None else []
+        lines += [f"natural frequencies by the method '{self.method}'"
                  + (f" (answered by its {self.route[k]} rung)" if self.route is not None else "") + ":",
                  f"{'':>4} {'omega [rad/s]':>16} {'f [Hz]':>14} {'period [s]':>14} {'rel. error <=':>14}"
                  + (f" {'damping ratio':>14} {'log. decr.':>11}" if damped else "")]
@@ -125,7 +140,8 @@ class Spectrum(Result):
             if grows[i - 1]:
                 row += f"   grows at {self.growth[k][i - 1]:.6g} 1/s"
             if self.steady is not None and self.steady[k, i - 1]:
-                row += f"   the steady {', '.join(model.meta.get('steady', {}))}: its own zero root (a free phase)"
+                steady = ", ".join(model.meta.get("steady", {})) if model is not None else "coordinate"
+                row += f"   the steady {steady}: its own zero root (a free phase)"
             lines.append(row)
         label = stab.label[k]
         note = {"unstable": f", {stab.unstable_roots[k]} growing root(s), the fastest at {stab.growth_rate[k]:.6g} 1/s",
@@ -152,21 +168,23 @@ class Spectrum(Result):
             s.route = np.array(s.route, dtype=object)
         return s
 
-    def plot(self, x=None, ax=None, label=None):
-        """Frequencies of every set against x (the set index by default), one curve a mode."""
-        plt = _pyplot()
-        if ax is None:
-            _, ax = plt.subplots(layout="constrained")
-        x = np.arange(len(self)) if x is None else x
-        for j in range(self.frequencies.shape[1]):
-            ax.plot(x, self.frequencies[:, j], lw=1, color="k", label=(label or self.method) if j == 0 else None)
-        ax.set_yscale("log")
-        ax.set_ylabel("natural frequency omega [rad/s]")
+    def plot(self, out=None, x=None, label=None, ax=None):
+        """Frequencies of every set against x (the set index by default), one curve a mode,
+        into `out` (a file, written whole or not at all, or matplotlib axes; `ax` the same);
+        with neither, into a new figure's axes, returned."""
+        if out is None and ax is None:
+            _, ax = _pyplot().subplots(layout="constrained")
+        with _axes(ax if ax is not None else out) as ax:
+            x = np.arange(len(self)) if x is None else x
+            for j in range(self.frequencies.shape[1]):
+                ax.plot(x, self.frequencies[:, j], lw=1, color="k", label=(label or self.method) if j == 0 else None)
+            ax.set_yscale("log")
+            ax.set_ylabel("natural frequency omega [rad/s]")
         return ax
 
 
 @dataclass
-class Stability:
+class Stability(Result):
     """Per set: 'stable', 'unstable' (with its growth rate, 1/s), 'marginal' (an exact zero
     root: a neutral direction), 'boundary' (rounding could change the verdict: two roots
     merged within their error bounds, or a root not resolved from zero), 'unknown' (a
@@ -178,6 +196,39 @@ class Stability:
     unstable_roots: np.ndarray  # (sets,) int: growing modes (eigenvalue pairs, or quadruples, with a growing member)
     slowest_growth: np.ndarray  # (sets,) smallest growing real part, 1/s (0 when stable)
     reason: np.ndarray | None = None  # (sets,) why a set is 'boundary' (gyro.results.verdict); None elsewhere
+
+    NO_PLOT = "a label per set: the figure of what holds it draws it (a map, a Campbell diagram, a sweep)"
+
+    def __len__(self) -> int:
+        return len(self.label)
+
+    def to_dict(self) -> dict:
+        """Per set: `stability` (the label), `growth_rate` and `slowest_growth` (1/s),
+        `unstable_roots`, `reason` (null, or why there is no plain verdict)."""
+        reason = self.reason if self.reason is not None else [None] * len(self)
+        num = lambda a: [float(g) if np.isfinite(g) else None for g in a]  # noqa: E731
+        return {"stability": [str(c) for c in self.label], "growth_rate": num(self.growth_rate),
+                "slowest_growth": num(self.slowest_growth),
+                "unstable_roots": [int(n) for n in self.unstable_roots], "reason": [r for r in reason]}
+
+    def table(self) -> str:
+        """A line per set: its label, the growing modes and the fastest rate, or the reason."""
+        d = self.to_dict()
+        lines = []
+        for k, label in enumerate(d["stability"]):
+            if label == "unstable":
+                n = d["unstable_roots"][k]
+                label += f" ({n} growing mode{'s' if n != 1 else ''}, the fastest at {self.growth_rate[k]:.4g} 1/s)"
+            elif d["reason"][k]:
+                label += f" ({d['reason'][k]})"
+            lines.append(f"{k + 1:>4}  {label}")
+        return "\n".join(lines)
+
+    @classmethod
+    def _loaded(cls, s) -> "Stability":
+        s.label = np.array(s.label, dtype=object)
+        s.reason = None if s.reason is None else np.array(s.reason, dtype=object)
+        return s
 
 
 def classify(spec: Spectrum, rel: float = 1e-9) -> Stability:
@@ -247,7 +298,7 @@ def _root(spec: Spectrum, k: int, j: int, digits: int) -> str:
 
 
 @dataclass
-class ModalResult:
+class ModalResult(Result):
     """Natural frequencies of a model at one parameter set, with the equilibrium used."""
 
     model: str
@@ -257,12 +308,23 @@ class ModalResult:
     eigenvalues_re: list = field(default_factory=list)  # real parts, same order (growth if > 0)
     error_estimate: list = field(default_factory=list)  # last Newton step, relative
 
-    def to_json(self) -> str:
-        return json.dumps(asdict(self), indent=1)
+    NO_PLOT = "one set's frequencies: a list (gyro frequencies prints them)"
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    def table(self) -> str:
+        lines = [f"{self.model}: natural frequencies at one set",
+                 f"{'':>4} {'omega [rad/s]':>16} {'Re lambda [1/s]':>16} {'rel. error <=':>14}"]
+        for i, w in enumerate(self.frequencies):
+            g = self.eigenvalues_re[i] if i < len(self.eigenvalues_re) else float("nan")
+            e = self.error_estimate[i] if i < len(self.error_estimate) else float("nan")
+            lines.append(f"{i + 1:>4} {cell(w, '>16.9g')} {cell(g, '>16.6g')} {cell(e, '>14.2g', 'unbounded')}")
+        return "\n".join(lines)
 
     def save(self, path) -> None:
-        with open(path, "w") as fh:
-            fh.write(self.to_json())
+        """Its JSON document (the one format it has had), written whole or not at all."""
+        _write_text(path, json.dumps(self.to_dict(), indent=1))
 
     @classmethod
     def load(cls, path) -> "ModalResult":

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gyro.results._io import Result, _finite_or_none, _pyplot, save_figure
+from gyro.results._io import Result, _axes, _finite_or_none
 from gyro.results.spectrum import Spectrum, classify
 
 
@@ -60,16 +60,14 @@ class FrequencySweep(Result):
                 f"{int(np.sum(c == 'unstable'))} unstable{rest})")
 
     def plot(self, out) -> None:
-        plt = _pyplot()
-        fig, ax = plt.subplots(figsize=(8, 6), layout="constrained")
-        self.spectrum.plot(self.x, ax=ax, label=f"method '{self.spectrum.method}'")
-        ax.set_xscale("log" if self.xlog else "linear")
-        ax.set_xlabel(f"{self.xname} [{self.xunit}]")
-        ax.set_title(f"Natural frequencies against {self.xname}: {self.title}", fontsize=10)
-        ax.grid(True, which="both", alpha=0.25)
-        ax.legend(fontsize=8)
-        save_figure(fig, out)
-        plt.close(fig)
+        """The frequencies against the swept parameter, into `out` (a file or axes)."""
+        with _axes(out, figsize=(8, 6)) as ax:
+            self.spectrum.plot(x=self.x, ax=ax, label=f"method '{self.spectrum.method}'")
+            ax.set_xscale("log" if self.xlog else "linear")
+            ax.set_xlabel(f"{self.xname} [{self.xunit}]")
+            ax.set_title(f"Natural frequencies against {self.xname}: {self.title}", fontsize=10)
+            ax.grid(True, which="both", alpha=0.25)
+            ax.legend(fontsize=8)
 
 
 # --------------------------------------------------------------------------- gyrohorizoncompass

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gyro.results._io import _pyplot, cell, mode_panels, save_figure
+from gyro.results._io import Result, _finish, cell, mode_panels
 from gyro.results.sensitivity import Sensitivities
 
 QUANTILE_LEVELS = (0.01, 0.5, 0.99)
@@ -19,7 +19,7 @@ def _num(v):
 
 
 @dataclass
-class ToleranceStudy:
+class ToleranceStudy(Result):
     model: str
     title: str
     samples: int
@@ -143,9 +143,8 @@ class ToleranceStudy:
 
     def plot(self, out, modes=None) -> None:
         """Histograms of each frequency (relative to nominal) with the first-order normal."""
-        plt = _pyplot()
         modes = list(range(len(self.nominal))) if modes is None else list(modes)
-        fig, axes = mode_panels(plt, len(modes), 2.5)
+        fig, axes = mode_panels(out, len(modes), 2.5)
         for ax, i in zip(axes.flat, modes):
             w0 = self.nominal[i]
             e = self.edges[i]
@@ -165,5 +164,4 @@ class ToleranceStudy:
         fig.supxlabel("frequency change from nominal [%]", fontsize=9)
         sp = ", ".join(f"{s['name']} {s['kind']} {100 * s['width']:g} %" for s in self.spreads)
         fig.suptitle(f"{self.title}: {self.samples:,} samples; {sp}", fontsize=9)
-        save_figure(fig, out)
-        plt.close(fig)
+        _finish(fig, out)

@@ -27,17 +27,34 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gyro.results._io import Result
+
 LABELS = ("stable", "marginal", "unstable", "boundary", "unknown", "failed")
 EPS = float(np.finfo(float).eps)  # 2 u: the spacing of doubles at 1
 UNIT_ROUNDOFF = EPS / 2  # u
 
 
 @dataclass
-class Verdict:
+class Verdict(Result):
     """Per set of a batch: its label (one of LABELS) and a reason (None, or one line)."""
 
     label: np.ndarray  # (sets,) object: str
     reason: np.ndarray  # (sets,) object: str or None
+
+    NO_PLOT = "a label per set: the figure of what holds it draws it (a map, a Campbell diagram)"
+
+    def to_dict(self) -> dict:
+        """Per set: `verdict` (the label) and `reason` (null, or one line)."""
+        return {"verdict": [str(v) for v in self.label], "reason": [None if r is None else str(r) for r in self.reason]}
+
+    def table(self) -> str:
+        """A line per set: its label, and its reason where it has one."""
+        return "\n".join(f"{k + 1:>4}  {v}" + (f" ({r})" if r else "") for k, (v, r) in
+                         enumerate(zip(self.label, self.reason)))
+
+    @classmethod
+    def _loaded(cls, v) -> "Verdict":
+        return make(v.label, v.reason)
 
     def __len__(self) -> int:
         return len(self.label)

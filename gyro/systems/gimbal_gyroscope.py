@@ -588,10 +588,17 @@ def turning_points(motion: Motion, n: int = 4096) -> np.ndarray:
 RTOL, ATOL = 1e-10, 1e-12  # the integrators' tolerances of `trajectory`
 
 
+# the series of a motion: name, unit, description (the Euler angles of the module's doc)
+SERIES = (("theta", "rad", "nutation: the casing's turn about its axis eta1 in the outer ring"),
+          ("psi", "rad", "precession of the outer ring about the vertical xi3"),
+          ("phi", "rad", "the rotor's spin about its symmetry axis eta3"))
+
+
 def trajectory(motion: Motion, t, method: str = "closed_form"):
     """theta, psi, phi at the times t by the closed form or an integrator, as a
-    gyro.results.Trajectory (with the motion type and the period from the closed form)."""
-    from gyro.results import Trajectory
+    gyro.results.Motion (with the integrals at t = 0 and, from the closed form, the motion
+    type and the period of theta in its `info`)."""
+    from gyro.results import Motion as MotionResult
 
     t = np.asarray(t, dtype=float)
     model = load(MODEL)
@@ -603,8 +610,17 @@ def trajectory(motion: Motion, t, method: str = "closed_form"):
     else:
         q, _ = integrate(motion, t, method, RTOL, ATOL, budget_s=BUDGET_SECONDS)
         theta, psi, phi = q[:, 1], q[:, 0], q[:, 2]
-    return Trajectory(MODEL, model.meta["title"], method, t, theta, psi, phi,
-                      motion.integrals0, kind, period)
+    I, title = motion.integrals0, model.meta["title"]
+    heading = [f"{title} ({MODEL}), method {method}",
+               f"integrals at t = 0: H = {I['H']:.9g}, L = {I['L']:.9g}, M = {I['M']:.9g}"]
+    if kind is not None:
+        shown = ("none (stationary or on the separatrix)" if not math.isfinite(period) else f"{period:.9g} s")
+        heading.append(f"motion: {kind}; period of theta {shown}")
+    names, units, descriptions = (list(c) for c in zip(*SERIES))
+    return MotionResult(MODEL, title, method, t, names, np.stack([theta, psi, phi], axis=1), units, descriptions,
+                  info={"integrals": I, "motion_type": kind, "period": period},
+                  keys=["t", *names, "method", "integrals"], heading=heading,
+                  formats={"t": ">14.6g", **{n: ">18.12g" for n in names}})
 
 
 def motion_answer(motion: Motion, t, method: str = "closed_form", rtol: float = RTOL):
@@ -638,7 +654,7 @@ def motion_answer(motion: Motion, t, method: str = "closed_form", rtol: float = 
 def simulate_command(model, args, cli):
     """`gyro simulate gimbal_gyroscope` (the model's `simulate` declaration): the parameters
     and the initial conditions INITIAL as --set NAME=VALUE, every input checked first; the
-    closed form (2.6) by default, or an integrator of METHODS. Returns the Trajectory."""
+    closed form (2.6) by default, or an integrator of METHODS. Returns the Motion."""
     from gyro.models import Param
 
     ic = {n: Param(n, u, d, desc, "real", (None, None)) for n, (u, d, desc) in INITIAL.items()}

@@ -393,13 +393,14 @@ def _why_stopped(level: str, P, y0, T: float, rtol_scale: float = 1.0, base=None
 
 
 def simulate(values: dict, t, level: str, rtol_scale: float = 1.0, base=None, multistep: str = "adams"):
-    """The motion of one level at the times t (t[0] = 0): ImagePointMotion. Singular when it
+    """The motion of one level at the times t (t[0] = 0): a gyro.results.Motion of the image
+    point x, y (22), the gimbal angles alpha, beta (rad) and the rotor momentum H (N m s),
+    with its `level`, `params` (by their command-line names), `seconds` (CPU time of the
+    integration) and `base_rate` (None, or the base's description). Singular when it
     reaches beta or alpha = +-90 deg; IntegrationBudget when the integrator stops by its
     step budget elsewhere. `base`: None (the constant base rate of the parameters) or a
     function of t giving (u_xi, u_eta, u_zeta) in rad/s (see the module's doc); its
     `describe()`, where it has one, is the result's `base_rate`."""
-    from gyro.results import ImagePointMotion
-
     if level not in LEVELS:
         raise ParameterError(f"--level: unknown level {level!r} of {MODEL}; known: {', '.join(LEVELS)}")
     t = np.asarray(t, float)
@@ -463,8 +464,34 @@ def simulate(values: dict, t, level: str, rtol_scale: float = 1.0, base=None, mu
                        "or the image point leaves the picture plane")
     described = getattr(base, "describe", None)
     x, y, alpha, beta, H = (np.asarray(v, float)[where] for v in (x, y, alpha, beta, H))
-    return ImagePointMotion(MODEL, level, named(values), t, x, y, alpha, beta, H, seconds,
-                            base_rate=described() if callable(described) else None)
+    return motion_result(level, named(values), t, np.stack([x, y, alpha, beta, H], axis=1), seconds,
+                         described() if callable(described) else None)
+
+
+# the series of a level's motion: name, unit, description, the table's column format
+SERIES = (("x", "", "the image point in the picture plane z = 1 (22)", ">16.10g"),
+          ("y", "", "the image point in the picture plane z = 1 (22)", ">16.10g"),
+          ("alpha", "rad", "the outer ring's angle", ">16.10g"),
+          ("beta", "rad", "the casing's angle", ">16.10g"),
+          ("H", "N m s", "the rotor's angular momentum", ">14.9g"))
+
+
+def motion_result(level: str, params: dict, t, values, seconds: float, base_rate: dict | None):
+    """The gyro.results.Motion of one level: `values` (times, 5) the SERIES; `base_rate` the
+    command line's {u_NAME: [{amplitude, frequency, phase}, ...]} of a time-varying base
+    (the JSON's `base_rate` and the table's lines), None for a constant one."""
+    from gyro.results import Motion
+
+    names, units, descriptions, formats = (list(c) for c in zip(*SERIES))
+    heading = [f"gimbal gyroscope on a rotating base ({MODEL}), level {level}"]
+    for name, terms in (base_rate or {}).items():
+        waves = " + ".join(f"{o['amplitude']:g} sin({o['frequency']:g} t + {o['phase']:g})" for o in terms)
+        heading.append(f"base rate {name}(t) = {name} + {waves} rad/s")
+    info = {"level": level, "params": params, "seconds": seconds, "base_rate": base_rate}
+    keys = ["model", "level", "params", "t", *names, "seconds"] + (["base_rate"] if base_rate is not None else [])
+    return Motion(MODEL, "gimbal gyroscope on a rotating base", level, t, names, values, units, descriptions,
+                  info=info, keys=keys, heading=heading, formats={"t": ">12.6g", **dict(zip(names, formats))},
+                  path=["x", "y"])
 
 
 def image_error(a, b) -> float:

@@ -490,18 +490,29 @@ def initial_state(values: dict, perturb=(0.0, 0.0, 0.0, 0.0)) -> np.ndarray:
 
 
 def trajectory(values: dict, t, perturb=(0.0, 0.0, 0.0, 0.0), method: str = "DOP853"):
-    """A perturbed motion about the relative equilibrium as a gyro.results.AngleTrajectory
-    (the command line's: within the integration budget)."""
-    from gyro.results import AngleTrajectory
+    """A perturbed motion about the relative equilibrium as a gyro.results.Motion: the
+    angles alpha, beta, gamma, epsilon and the integral E along it, whose relative drift
+    max |E - E(0)| / |E(0)| is its `drift` (the command line's: within the integration
+    budget)."""
+    from gyro.results import Motion
 
     t = np.asarray(t, float)
     y0 = initial_state(values, perturb)
     Y = integrate(values, y0, t, method, budget_s=BUDGET_SECONDS, budget_steps=BUDGET_STEPS)
     if not np.all(np.isfinite(Y)):
         raise FloatingPointError(f"{method}: a coordinate is not finite")
-    return AngleTrajectory(model=MODEL, title=model().meta["title"], method=method, t=t,
-                           coordinates=("alpha", "beta", "gamma", "epsilon"), q=Y[:, :4],
-                           E=energy(values, Y), params=cli_params(values))
+    E = energy(values, Y)
+    dE = np.max(np.abs(E - E[0]))
+    drift = float(dE / abs(E[0])) if E[0] != 0 else float(dE)
+    angles = ["alpha", "beta", "gamma", "epsilon"]
+    title = model().meta["title"]
+    return Motion(MODEL, title, method, t, [*angles, "E"], np.column_stack([Y[:, :4], E]), ["rad"] * 4 + [""],
+                  [f"the angle {a} (3.1)" for a in angles] + ["the integral E (2.3)"],
+                  info={"params": cli_params(values), "drift": drift}, keys=["t", *angles, "E", "method"],
+                  heading=[f"{title} ({MODEL}), method {method}",
+                           f"E(0) = {E[0]:.12g}; max |E - E(0)|/|E(0)| = {drift:.2g}"],
+                  shown=angles, formats={"t": ">12.6g", **{a: ">18.11g" for a in angles}}, gap="",
+                  invariants=["E"])
 
 
 # ------------------------------------------------------------------ the motion question
@@ -586,7 +597,7 @@ def simulate_command(model, args, cli):
     """`gyro simulate gyrohorizoncompass` (the model's `simulate` declaration): every input
     checked first (names, numbers, equilibrium, --perturb as D1,D2,D3,D4 or NAME=VALUE
     over ANGLES, --t-end, --points, --method, --out), then integrated. Returns the
-    AngleTrajectory."""
+    Motion."""
     values = parameters(cli.sets(args.set))
     perturb = [0.0] * 4
     if args.perturb is not None and (len(args.perturb) > 1 or "=" in args.perturb[0]):

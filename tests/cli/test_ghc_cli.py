@@ -385,7 +385,7 @@ def test_the_gimbal_refuses_perturb_and_keeps_its_default():
 
 
 def test_results_round_trip(tmp_path):
-    from gyro.results import AngleTrajectory, ConditionMap, EquilibriumStability
+    from gyro.results import EquilibriumStability, Map, Motion
 
     v = ghc.parameters(LAB)
     s = ghc.stability(v)
@@ -393,11 +393,12 @@ def test_results_round_trip(tmp_path):
     assert EquilibriumStability.load(tmp_path / "s.npz").to_dict() == s.to_dict()
     m = ghc.condition_map(dict(v), ("zeta", 0.1, 0.8, 4), ("eta", 0.0, 0.9, 5))
     m.save(tmp_path / "m.npz")
-    m2 = ConditionMap.load(tmp_path / "m.npz")
+    m2 = Map.load(tmp_path / "m.npz")
     assert m2.to_dict() == m.to_dict() and m2.counts() == m.counts()
     tr = ghc.trajectory(v, np.linspace(0, 2, 3), (0.01, 0, 0, 0), "cvodes")
     tr.save(tmp_path / "t.npz")
-    assert AngleTrajectory.load(tmp_path / "t.npz").to_dict() == tr.to_dict()
+    back = Motion.load(tmp_path / "t.npz")
+    assert back.to_dict() == tr.to_dict() and back.table() == tr.table()
     tr.plot(tmp_path / "t.png")
     assert (tmp_path / "t.png").stat().st_size > 1000
 

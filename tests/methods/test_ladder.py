@@ -665,3 +665,23 @@ def test_the_formulas_outputs_in_huge_pages_are_plain_writable_arrays():
     P = np.tile(params(), (30000, 1))
     s = ladder.spectrum(MODEL, P, "formulas")
     np.testing.assert_array_equal(s.frequencies, np.tile(ladder.spectrum(MODEL, P[:1], "formulas").frequencies, (30000, 1)))
+
+
+def test_polyroots_loses_a_root_to_overflow_without_a_warning():
+    """A set of the wide spreads (issue 36) on which the determinant polynomial's root
+    estimate overflows: that root is answered with no bound (inf), and no RuntimeWarning
+    reaches the caller of the API (it did: 'overflow encountered in divide')."""
+    import warnings
+
+    from gyro.models import load
+
+    tg = load("torsion_gyrocompass")
+    P = np.array([[0.4, 0.6, 0.15, 0.060341442310162696, 0.38448783653475593, 0.00021822064929620196,
+                   0.0004888161359542044, 0.005673558477568775, 0.006861221680933348, 0.00023630758107290843,
+                   26108.15689035862, 179720.65625778586, 2.117634118678118, 0.2110216246861012,
+                   0.0005962656334723807, 46.47128799627344, 9.81, 0.012435236567161171, 0.0, 0.0, 0.0]])
+    assert P.shape[1] == len(tg.param_names)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        s = ladder.spectrum(tg, P, "polyroots")
+    assert np.isinf(s.error_estimate).any() and not np.isnan(s.error_estimate).any()

@@ -190,7 +190,7 @@ def test_cli_contract(tg, nominal):
 
 def test_tornado_chart(nominal, tmp_path):
     out = tmp_path / "tornado.png"
-    nominal.tornado(out, modes=[0, 7], title="two modes")
+    nominal.plot(out, modes=[0, 7], title="two modes")
     assert out.stat().st_size > 5_000
     rc, out, err = run_cli("frequencies", MODEL, "--sensitivities", "--method", "formulas")
     assert rc == 2 and "--sensitivities" in err and len(err.strip().splitlines()) == 1

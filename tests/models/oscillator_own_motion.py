@@ -31,7 +31,7 @@ def build() -> Model:
 
 def simulate_command(model, args, cli):
     from gyro.errors import finite_number
-    from gyro.results.trajectory import CoordinateMotion
+    from gyro.analyses.motion import coordinate_motion
 
     sets = cli.sets(args.set)
     init = {n: finite_number(f"parameter {n}", sets.pop(n, d)) for n, (_, d, _) in INITIAL.items()}
@@ -42,6 +42,4 @@ def simulate_command(model, args, cli):
     w = np.sqrt(values["k"] / values["m"])
     x = init["x0"] * np.cos(w * t) + init["v0"] / w * np.sin(w * t)
     v = -init["x0"] * w * np.sin(w * t) + init["v0"] * np.cos(w * t)
-    return CoordinateMotion(model=model.name, title=model.meta["title"], method="closed_form", t=t,
-                            coordinates=["x"], units=["m"], q=x[:, None], qd=v[:, None], params=values,
-                            perturb=init, equilibrium={})
+    return coordinate_motion(model, "closed_form", t, x[:, None], v[:, None], values, init, {})

@@ -64,14 +64,43 @@ def _ran(monkeypatch, model) -> tuple[list, Derivation]:
 
 @pytest.mark.parametrize("linear", [True, False])
 def test_the_constraints_pass_chooses_elimination_or_multipliers(monkeypatch, linear):
+    """Either way every pass runs, in order: the multipliers route forms its equations,
+    reference, operator and B in the same passes as the coordinates route (with the
+    multiplier columns), so that no step added to one is silently lacking on the other."""
     ran, d = _ran(monkeypatch, _pendulum(holonomic_y=linear))
-    if linear:  # eliminated: every pass of the coordinates route, in order
-        assert ran == [m.__name__.rsplit(".", 1)[-1] for m in passes.passes() if "coordinates" in m.ROUTES]
+    assert ran == [m.__name__.rsplit(".", 1)[-1] for m in passes.passes()]
+    if linear:  # eliminated
         assert d.route == "coordinates" and d.model.coordinates == ["x"] and "eliminated" in d.constraints
-    else:  # multipliers: the constraints pass formed the equations, the operator; then only
-        # the passes of the multipliers route
-        after = [m.__name__.rsplit(".", 1)[-1] for m in passes.passes() if "multipliers" in m.ROUTES]
-        assert ran == ["conversion", "constraints"] + [n for n in after if n not in ("conversion", "constraints")]
+    else:
         assert d.route == "multipliers" and d.constraints["multipliers"] == ["lam1"]
         assert d.mass_matrix.shape == (3, 3) and d.operator.M.shape == (1, 1)
+        assert d.route_agreement is None and d.even == list(d.model.q)
     assert d.timings and not vars(d.work)  # what passes handed on is gone
+
+
+def test_every_pass_runs_on_both_routes():
+    """A pass for one route only would leave the other without its step (the multipliers
+    route once formed its equations and operator apart, without the passes' checks)."""
+    for m in passes.passes():
+        assert set(m.ROUTES) == ROUTES, m.__name__
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_the_routes_check_compares_30_digit_values_either_way(monkeypatch, compiled):
+    """The two routes' check (derive/passes/operator.py) by N(entry, 30), or compiled in
+    mpmath with 60 working digits and each value rounded to 30 (large operators): equal
+    entries written differently (sin^2 + cos^2 against 1, a product against its expansion)
+    compare to exactly 0, and a term of relative size 1e-12 is seen."""
+    from derive import mechanics as mech
+    from derive.passes import operator as op_pass
+
+    monkeypatch.setattr(op_pass, "COMPILE_NODES", 0 if compiled else 10**9)
+    th, a, b = sp.symbols("theta a b")
+    M1 = sp.Matrix([[a * (sp.sin(th) ** 2 + sp.cos(th) ** 2), (a + b) ** 3], [b / (1 + sp.tan(th) ** 2), a]])
+    M2 = sp.Matrix([[a, sp.expand((a + b) ** 3)], [b * sp.cos(th) ** 2, a]])
+    K = sp.Matrix([[sp.exp(th) * a, 0], [0, b]])
+    same = op_pass.compare_operators(mech.LinearOperator(M1, M1 * 0, K), mech.LinearOperator(M2, M2 * 0, K))
+    assert same == 0.0
+    off = op_pass.compare_operators(mech.LinearOperator(M1, M1 * 0, K),
+                                    mech.LinearOperator(M2, M2 * 0, K + sp.Matrix([[0, 0], [0, b * 1e-12]])))
+    assert 1e-14 < off < 1e-11

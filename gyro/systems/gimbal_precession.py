@@ -30,6 +30,7 @@ import time
 import warnings
 from dataclasses import dataclass
 from functools import lru_cache
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -506,48 +507,61 @@ def image_error(a, b) -> float:
 
 # ----------------------------------------------------------------------------- the levels' bounds
 #
-# Each level's error against `full`, estimated along the level's own motion (docs/precession.md,
-# "The bound of each level"):
-# - the defect: the rates of the full equations minus the level's at each state of the level's
-#   motion, to first order. The full equations' residual R = Mq q'' - f along the motion (q'
-#   from (13), q'' by differences on a grid fine enough for the motion's fastest frame rate)
-#   is exactly the moment of what the precession theory neglects (the rings' inertia with
-#   the outer ring's (C2 - C1) w_eta1 w_zeta1, the rotor's transverse momentum), since the
-#   motion satisfies (12) with the momentum H e_z' alone; the full rates differ from (12)'s by
-#   A12^-1 R (A12 the matrix of (12) in alpha', beta', H': the sec(beta) by which a moment
-#   about the outer axis turns the casing). `small` and `elementary` add their rates' difference
-#   from (21) at the same state. The defect is measured as the spin axis's rate on the unit
-#   sphere (cos(beta) d alpha', d beta') and d H'/H0;
-# - the defect carried along the level's flow: e' <= mu(t) e + |d(t)|, mu the logarithmic norm
-#   of the flow's Jacobian in the same measure (a rotation of the base is an isometry of the
-#   sphere: mu = 0 for it); the image point's error is rho^2 e (the gnomonic projection's
-#   radial scale), the largest over the horizon;
-# - the nutation: the precession is the slow motion only while the frames' rates are small
-#   against H |cos(beta)|/J (J the sum of the transverse moments, a lower bound of the
-#   nutation frequency's); above NUTATION_RATIO the bound is infinite (the level refuses);
-#   below it, the nutation a rate defect d excites, at most 2 |d| J/(H |cos beta|) off the
-#   drift (a cycloid), is added to e (it matters where the horizon is a few nutation periods);
-# - the integrator: the answer (Adams, rtol 1e-12) against an independent method (BDF with
-#   Newton's iteration, same tolerance) and against Adams 100x looser, twice the larger.
-# The model term is SAFETY times the first-order estimate; relative to the motion's largest
-# excursion from its start.
+# Each level's error against `full`, enclosed along the level's own motion (docs/precession.md,
+# "The bound of each level", the derivation step by step). In s = (alpha, beta, H) and the
+# full level's angle rates v, the full equations are exactly (the phi row eliminated: H is
+# the rotor's axial momentum, H' = g(s, v) in every level)
+#     Mr(q) v' + hrest(s, v) + Kg(s) v - cg(s) = 0,    H' = g(s, v),
+# Mr the rings' and the rotor's transverse inertia (the Schur complement of the mass matrix
+# on phi), Kg v - cg the rows alpha, beta of (12) (Kg = H cos(beta) times a rotation plus
+# the friction's symmetric part), hrest the rest of the Lagrange terms of the rings and the
+# rotor's transverse momentum (the outer ring's (C2 - C1) w_eta1 w_zeta1 among them). The
+# precession (13) is Kg f = cg: s' = Phi(s) = (f(s), g(s, f(s))). With w = v - f(s) and
+# B(s) = (I; dg/dv), s' = Phi(s) + B w exactly, and
+# - the energy of w: d/dt (w.Mr w/2) = -w.rho0(s) + w.Q(s) w exactly (no cubic term: the
+#   Lagrangian's structure; rho0 = hrest(s, f) + Mr Df Phi, the residual of the full
+#   equations along the precession's vector field), so |w|_Mr <= W, W' = lambda W +
+#   |rho0|_Mr^-1, lambda the largest eigenvalue of Q against Mr (the friction in Q: < 0);
+# - the momentum: Kg w = -(Mr v' + hrest), so with P = Kg^-1 Mr v the slow variable z = s +
+#   B P moves at z' = Phi(s) + sigma(s, v), sigma = B' P + B ((Kg^-1 Mr)' v - Kg^-1 hrest),
+#   quadratic in v: no v' in it (the nutation is inside W);
+# - z - s_l (s_l the level's motion, s_l' = Phi(s_l) - d_l, d_l its rates' difference from
+#   (13) at its own state: 0 for rigorous and image) in the metric G = diag(cos beta_l, 1,
+#   1/H0) (the spin axis on the unit sphere, the momentum relative): E' = mu E + L |G B P|
+#   + |G sigma| + |G d_l|, E(0) = |G B P(0)| (full starts on (13): w(0) = 0), mu the
+#   logarithmic norm of G DPhi G^-1 + G' G^-1 over the tube, L the norm of G DPhi G^-1;
+# - the error s - s_l within E + |G B P| on the sphere, the image point within rho^2 of it.
+# Every constant is the largest over the tube |G (s - s_l)| <= r about the level's motion
+# (the centre and the six axial points at radius r, with twice their spread as the
+# allowance for the rest of the ball) and over each step (the larger end plus the steps'
+# difference as the allowance between samples, plus a floor: FLOOR_ALLOWANCE). The radius
+# is closed by a bootstrap: the bound computed with the constants of radius r must come out below r, else r is raised;
+# a tube that reaches beta or alpha = +-90 deg, or no closing within BOOTSTRAP tries: the
+# level refuses (the bound is infinite).
+# The integrator's term: the answer (Adams, rtol 1e-12) against an independent method (BDF
+# with Newton's iteration, same tolerance) and against Adams 100x looser, twice the larger.
 
-SAFETY = 2.0
 LOOSE = 100.0
 INTEGRATION_SAFETY = 2.0
-PER_RADIAN = 20  # samples of the bound's grid per radian of the fastest frame rate (q'' by differences)
+PER_RADIAN = 20  # samples of the bound's grid per radian of the fastest frame rate
 MAX_SAMPLES = 200_000  # a motion that needs more: the bound is not evaluated (infinite)
-NUTATION_RATIO = 0.1  # (|u| + |alpha'| + |beta'|) J/(H |cos beta|) above it: no precession level answers
+MIN_SAMPLES = 41  # the bound's grid has at least these
+BOOTSTRAP = 6  # tries to close the tube's radius
+TUBE_GROWTH = 2.0  # a try that does not close raises the radius to this times its bound
+BALL_ALLOWANCE = 2.0  # the tube's constant: the centre's plus this times the axial points' spread
+# and each step's plus this times the constant's largest magnitude over the horizon; |rho1|, second
+# order and computed with cancellation, also RHO1_FLOOR times |rho0|'s largest (measured, `python -m
+# bench.precession_bounds 11 --allowances 16`: random points of the ball and a 4x denser grid
+# exceeded the sampled maxima by 3e-7 of that magnitude (|rho1|) where the tube's radius is 1e-10
+# rad or more, 2e-5 at 1e-20..1e-10 rad (|rho1| 0.97, where it is 1e-7..1e-5 of |rho0|), none
+# with the floors; 0.98 on motions of rounding size, a model term of 1e-26 against the
+# integrator's 1e-12)
+FLOOR_ALLOWANCE = 1e-2
+RHO1_FLOOR = 1e-4
 
 
 def _scale(m) -> float:
     return float(np.hypot(m.x - m.x[0], m.y - m.y[0]).max())
-
-
-def transverse_inertia(values: dict) -> float:
-    """J: the sum of every moment of inertia besides the rotor's momentum, the largest any
-    axis of the gimbal can have (the nutation frequency is at least H |cos beta|/J)."""
-    return sum(float(values[k]) for k in ("C1", "C2", "C3", "B1", "B2", "B3", "A1", "A1", "A3"))
 
 
 def _solve_rows(A, b):
@@ -569,66 +583,170 @@ def _image_to_angle_rates(x, y, dx, dy):
     return -dy / r2, ds / (1 + s**2)
 
 
-def defect(values: dict, m) -> np.ndarray:
-    """(n, 3): the full rates minus the level's along its motion m, to first order, in
-    alpha', beta', H' (see above): A12^-1 R, plus for small and elementary their rates'
-    difference from (21)."""
-    nf = load(MODEL).numpy
-    P = vector(values)
-    ab = np.stack([m.alpha, m.beta], axis=-1)
-    r3 = _rigorous(P, m.alpha, m.beta, m.H)
-    ad, bd = r3[:, 0], r3[:, 1]
-    pd = nf.spin_from_momentum(P, ab, np.stack([ad, bd], axis=-1), m.H[:, None])[:, 0]
-    q = np.stack([m.alpha, m.beta, np.zeros_like(m.t)], axis=-1)
-    qd = np.stack([ad, bd, pd], axis=-1)
-    qdd = np.gradient(qd, m.t, axis=0, edge_order=2)
-    R = np.einsum("nij,nj->ni", nf.mass_matrix(P, q), qdd) - nf.forcing(P, q, qd)
-    A12, b12 = nf.virtual_power_system(P, ab, m.H[:, None])
-    out = _solve_rows(A12, R)
-    if m.level in ("small", "elementary"):
-        xy, Hs = np.stack([m.x, m.y], axis=-1), m.H[:, None]
-        img = _solve_rows(*nf.image_system(P, xy, Hs))
-        own = _solve_rows(*getattr(nf, f"{m.level}_system")(P, xy, Hs))
-        d = img - own
-        da, db = _image_to_angle_rates(m.x, m.y, d[:, 0], d[:, 1])
-        out = out + np.stack([da, db, d[:, 2]], axis=-1)
+@lru_cache(maxsize=1)
+def _split():
+    """The CasADi pieces of the full equations at a state s = (alpha, beta, H) and angle
+    rates v (see above): (p, s, v, Mr, hrest, Kg, cg, g), from the generated mass matrix,
+    forcing, spin_from_momentum and virtual_power_system."""
+    import casadi as ca
+
+    cf = load(MODEL).casadi
+    p = ca.SX.sym("p", len(load(MODEL).param_names))
+    s, v = ca.SX.sym("s", 3), ca.SX.sym("v", 2)
+    ang, H = s[:2], s[2]
+    q3 = ca.vertcat(ang, 0)  # phi is cyclic
+    M3 = cf.mass_matrix(p, q3)
+    F3 = cf.forcing(p, q3, ca.vertcat(v, cf.spin_from_momentum(p, ang, v, H)))
+    Mr = M3[:2, :2] - M3[:2, 2] @ M3[2, :2] / M3[2, 2]  # the phi row eliminated (phi'' from it)
+    N = -(F3[:2] - M3[:2, 2] * F3[2] / M3[2, 2])  # full: Mr v' + N(s, v) = 0
+    A12, b12 = cf.virtual_power_system(p, ang, H)
+    g = (b12[2] - A12[2, :2] @ v) / A12[2, 2]  # H' from the phi row of (12): the full level's too
+    prec = -(A12[:2, :2] @ v + A12[:2, 2] * g - b12[:2])  # the rows alpha, beta of (12), as in N
+    Kg = ca.jacobian(prec, v)
+    cg = -ca.substitute(prec, v, ca.DM.zeros(2))
+    return p, s, v, Mr, N - prec, Kg, cg, g
+
+
+@lru_cache(maxsize=1)
+def _expressions() -> dict:
+    """The enclosure's pieces as CasADi expressions of the parameters p, the state s and a
+    rate deviation w (or om = w - eta, the symbol o): Phi, DPhi, f, eta, rho1, Q, Mr, B Kg^-1
+    Mr, D pi, sigma at v = f + w, and the energy rate of om (a polynomial of degree 2 in o:
+    the Lagrangian's cubic terms cancel; tests check it)."""
+    import casadi as ca
+
+    p, s, v, Mr, hrest, Kg, cg, g = _split()
+    f = ca.solve(Kg, cg)
+    Phi = ca.vertcat(f, ca.substitute(g, v, f))
+    DPhi = ca.jacobian(Phi, s)
+    Df = DPhi[:2, :]
+    w, o = ca.SX.sym("w", 2), ca.SX.sym("o", 2)
+    vw = f + w
+    sdot = ca.vertcat(vw, ca.substitute(g, v, vw))  # s' of the full motion at v = f + w
+    rho0 = ca.substitute(hrest, v, f) + Mr @ Df @ Phi  # the full equations' residual along Phi
+    eta = -ca.solve(Kg, rho0)  # w's slow part: the first-order rate defect
+    # d/dt (om.Mr om/2) along the full equations, om = w - eta: Mr v' = -N(s, v), w' = v' - Df s'
+    wdot = ca.solve(Mr, -ca.substitute(hrest + Kg @ v - cg, v, vw)) - Df @ sdot
+    om = w - eta
+    energy = ca.substitute(om.T @ ca.jtimes(Mr, s, sdot) @ om / 2 + om.T @ Mr @ (wdot - ca.jtimes(eta, s, sdot)),
+                           w, eta + o)
+    B = ca.vertcat(ca.DM.eye(2), ca.jacobian(g, v))
+    KiM = ca.solve(Kg, Mr)
+    sigma = (ca.jtimes(B, s, sdot) @ KiM @ vw + B @ (ca.jtimes(KiM, s, sdot) @ vw
+                                                      - ca.solve(Kg, ca.substitute(hrest, v, vw))))
+    return {"p": p, "s": s, "w": w, "o": o, "Phi": Phi, "DPhi": DPhi, "f": f, "eta": eta, "energy": energy, "rho0": rho0,
+            "Mr": Mr, "BKM": B @ KiM, "Dpi": ca.jacobian(B @ KiM @ f, s), "sigma": sigma}
+
+
+@lru_cache(maxsize=1)
+def _tube_function():
+    """A CasADi Function of (p, s) giving, stacked in one column, what the enclosure needs at
+    a state s: Phi (3), DPhi (3x3), rho1 (2), Q (2x2), Mr (2x2), eta (2), B Kg^-1 Mr (3x2),
+    D pi (3x3) (pi = B Kg^-1 Mr f, the nutation's centre), sigma(s, f) (3), d sigma/dw (3x2),
+    d2 sigma/dw2 (3 of 2x2)."""
+    import casadi as ca
+
+    e = _expressions()
+    w, o, sigma, energy = e["w"], e["o"], e["sigma"], e["energy"]
+    rho1 = -ca.gradient(energy, o)
+    Q = ca.hessian(energy, o)[0] / 2
+    s1 = ca.jacobian(sigma, w)
+    s2 = [ca.hessian(sigma[i], w)[0] for i in range(3)]
+    outs = [e["Phi"], e["DPhi"], rho1, Q, e["Mr"], e["eta"], e["BKM"], e["Dpi"], sigma, s1, *s2, e["rho0"]]
+    outs = [ca.substitute(ca.substitute(ca.vec(x), w, ca.DM.zeros(2)), o, ca.DM.zeros(2)) for x in outs]
+    return ca.Function("precession_tube", [e["p"], e["s"]], [ca.vertcat(*outs)], {"cse": True})
+
+
+def _at(values: dict, S: np.ndarray) -> dict:
+    """The tube function at the states S (n, 3), unpacked (each (n, ...))."""
+    col = np.array(_tube_function()(vector(values), S.T)).T
+    shapes = {"Phi": (3,), "DPhi": (3, 3), "rho1": (2,), "Q": (2, 2), "Mr": (2, 2), "eta": (2,), "BKM": (3, 2),
+              "Dpi": (3, 3), "sigma": (3,), "s1": (3, 2), "s2": (3, 2, 2), "rho0": (2,)}
+    out, k = {}, 0
+    for name, shape in shapes.items():
+        size = int(np.prod(shape))
+        block = col[:, k:k + size]
+        if len(shape) == 2:  # CasADi's vec is column-major
+            block = block.reshape(-1, shape[1], shape[0]).transpose(0, 2, 1)
+        elif len(shape) == 3:
+            block = block.reshape(-1, shape[0], shape[2], shape[1]).transpose(0, 1, 3, 2)
+        out[name] = block.reshape((-1, *shape))
+        k += size
     return out
 
 
-def log_norm(values: dict, m) -> np.ndarray:
-    """mu(t): the logarithmic norm of the Jacobian of (13)'s rates in the measure w =
-    (cos(beta) d alpha, d beta, d H/H0) (the spin axis's displacement on the unit sphere and
-    the momentum's relative change), by central differences along the motion m."""
+def _norm2(A):
+    return np.linalg.norm(A, ord=2, axis=(-2, -1))
+
+
+def _constants(c: dict, Gd: np.ndarray, Gdot: np.ndarray, kappa: np.ndarray) -> dict:
+    """The enclosure's constants from the tube function's values c (`_at`) at n states, in
+    the metric diag(Gd) (n, 3) with G' G^-1 = diag(Gdot), kappa (n, 3) the drift of the
+    nutation's centre along the level's motion: each a number per state."""
+    Mr = c["Mr"]
+    Li = np.linalg.inv(np.linalg.cholesky(Mr))
+    Qs = (c["Q"] + np.transpose(c["Q"], (0, 2, 1))) / 2
+    GD = Gd[:, :, None] * c["DPhi"] / Gd[:, None, :]
+    Wsym = (GD + np.transpose(GD, (0, 2, 1))) / 2 + np.einsum("ni,ij->nij", Gdot, np.eye(3))
+    return {"lam": np.linalg.eigvalsh(Li @ Qs @ np.transpose(Li, (0, 2, 1)))[:, -1],
+            "rho": np.linalg.norm(np.einsum("nij,nj->ni", Li, c["rho1"]), axis=-1),  # |rho1|_Mr^-1
+            "rho0": np.linalg.norm(np.einsum("nij,nj->ni", Li, c["rho0"]), axis=-1),  # its floor's scale
+            "eta": np.linalg.norm(c["eta"], axis=-1), "eta_M": np.sqrt(np.einsum("ni,nij,nj->n", c["eta"], Mr, c["eta"])),
+            "mmin": np.linalg.eigvalsh(Mr)[:, 0], "mu": np.linalg.eigvalsh(Wsym)[:, -1], "L": _norm2(GD),
+            "PK": _norm2(Gd[:, :, None] * c["BKM"]), "Lpi": _norm2(Gd[:, :, None] * c["Dpi"] / Gd[:, None, :]),
+            "chi": np.linalg.norm(Gd * (c["sigma"] - kappa), axis=-1), "s1": _norm2(Gd[:, :, None] * c["s1"]),
+            "s2": np.sqrt(np.sum((Gd[:, :, None, None] * c["s2"])**2, axis=(1, 2, 3)))}
+
+
+def _over_tube(values, S, own, Gd, Gdot, kappa, r) -> dict:
+    """Each constant's largest over the tube of radius r about the states S: the centre's
+    plus BALL_ALLOWANCE times the largest spread of the six axial points (for mmin the
+    smallest, the same way); then over each step: the larger end plus the ends' difference,
+    plus FLOOR_ALLOWANCE times its largest magnitude over the horizon (|rho1| also RHO1_FLOOR
+    times |rho0|'s largest).
+    Returns per step (n - 1); `own` the tube function at S."""
+    centre = _constants(own, Gd, Gdot, kappa)
+    if r > 0:
+        spread = {k: np.zeros_like(v) for k, v in centre.items()}
+        for j in range(3):
+            for sign in (-1.0, 1.0):
+                Sj = S.copy()
+                Sj[:, j] += sign * r / Gd[:, j]
+                cj = _constants(_at(values, Sj), Gd, Gdot, kappa)
+                for k in centre:
+                    spread[k] = np.maximum(spread[k], np.abs(cj[k] - centre[k]))
+        tube = {k: centre[k] + BALL_ALLOWANCE * spread[k] for k in centre}
+        tube["mmin"] = centre["mmin"] - BALL_ALLOWANCE * spread["mmin"]
+    else:
+        tube = centre
+    step = {}
+    for k, v in tube.items():
+        a, b = v[:-1], v[1:]
+        floor = FLOOR_ALLOWANCE * float(np.max(np.abs(v)))
+        if k == "rho":
+            floor += RHO1_FLOOR * float(np.max(tube["rho0"]))
+        step[k] = (np.minimum(a, b) - np.abs(b - a) - floor) if k == "mmin" else (np.maximum(a, b) + np.abs(b - a) + floor)
+    return step
+
+
+def _level_defect(values: dict, m) -> np.ndarray:
+    """(n, 3): d_l = Phi(s_l) - s_l', the rates of (13) minus the level's at the level's own
+    state, in alpha', beta', H' (0 for rigorous and image: (21) is (13) in x, y exactly)."""
+    if m.level not in ("small", "elementary"):
+        return np.zeros((len(m.t), 3))
+    nf = load(MODEL).numpy
     P = vector(values)
-    st = np.stack([m.alpha, m.beta, m.H], axis=-1)
-    H0 = abs(float(values["H"]))
-    steps = np.array([1e-6, 1e-6, 1e-6 * H0])
-    J = np.empty((len(m.t), 3, 3))
-    for j in range(3):
-        hi, lo = st.copy(), st.copy()
-        hi[:, j] += steps[j]
-        lo[:, j] -= steps[j]
-        J[:, :, j] = (_rigorous(P, *hi.T) - _rigorous(P, *lo.T)) / (2 * steps[j])
-    Sd = np.stack([np.cos(m.beta), np.ones_like(m.t), np.full_like(m.t, 1 / H0)], axis=-1)
-    W = Sd[:, :, None] * J / Sd[:, None, :]
-    W[:, 0, 0] -= np.tan(m.beta) * _rigorous(P, m.alpha, m.beta, m.H)[:, 1]  # d cos(beta)/dt / cos(beta)
-    return np.linalg.eigvalsh((W + np.transpose(W, (0, 2, 1))) / 2)[:, -1]
-
-
-def _carried(t, mu, d) -> np.ndarray:
-    """e(t) with e' = mu e + |d|, e(0) = 0, step by step (mu the larger of each step's ends)."""
-    e = np.zeros_like(t)
-    for k in range(len(t) - 1):
-        h = t[k + 1] - t[k]
-        g = np.exp(max(mu[k], mu[k + 1]) * h)
-        e[k + 1] = e[k] * g + h * (d[k] * g + d[k + 1]) / 2
-    return e
+    xy, Hs = np.stack([m.x, m.y], axis=-1), m.H[:, None]
+    d = _solve_rows(*nf.image_system(P, xy, Hs)) - _solve_rows(*getattr(nf, f"{m.level}_system")(P, xy, Hs))
+    da, db = _image_to_angle_rates(m.x, m.y, d[:, 0], d[:, 1])
+    return np.stack([da, db, d[:, 2]], axis=-1)
 
 
 def _bound_grid(values: dict, m):
     """The level's motion on a grid with PER_RADIAN samples per radian of the fastest frame
-    rate (the base's |u| plus the largest |alpha'| + |beta'| of (13) on m), m itself where it
-    is dense enough; None where that takes more than MAX_SAMPLES."""
+    rate (the base's |u| plus the largest |alpha'| + |beta'| of (13) on m), at least
+    MIN_SAMPLES: m's own samples, thinned, where it is denser; None where that takes more
+    than MAX_SAMPLES."""
     P = vector(values)
     r3 = _rigorous(P, m.alpha, m.beta, m.H)
     u = float(np.linalg.norm([values[b] for b in BASE]))
@@ -636,36 +754,84 @@ def _bound_grid(values: dict, m):
     n = int(np.ceil(float(m.t[-1]) * w * PER_RADIAN)) + 1
     if n > MAX_SAMPLES:
         return None
-    return m if n <= len(m.t) else simulate(values, np.linspace(0.0, float(m.t[-1]), n), m.level)
+    if n > len(m.t):
+        return simulate(values, np.linspace(0.0, float(m.t[-1]), n), m.level)
+    keep = np.unique(np.linspace(0, len(m.t) - 1, max(n, MIN_SAMPLES)).round().astype(int))
+    if len(keep) >= len(m.t):
+        return m
+    return SimpleNamespace(level=m.level, t=m.t[keep], x=m.x[keep], y=m.y[keep], alpha=m.alpha[keep],
+                           beta=m.beta[keep], H=m.H[keep])
 
 
-def slow_against_nutation(values: dict, m) -> bool:
-    """(|u| + |alpha'| + |beta'|) J/(H |cos beta|) <= NUTATION_RATIO at every sample of m
-    (alpha', beta' those of (13))."""
-    r3 = _rigorous(vector(values), m.alpha, m.beta, m.H)
-    u = float(np.linalg.norm([values[b] for b in BASE]))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = (u + np.abs(r3[:, 0]) + np.abs(r3[:, 1])) * transverse_inertia(values) / (
-            np.abs(m.H) * np.abs(np.cos(m.beta)))
-    return bool(np.all(ratio <= NUTATION_RATIO))
+EDGE = float(np.arccos(SINGULAR_COS))  # a tube past this angle reaches the singularity
 
 
-def model_error(values: dict, m) -> float:
-    """The first-order estimate of the largest |P_level - P_full| over the horizon (absolute,
-    before SAFETY); inf where the precession is not the slow motion or the grid would be too
-    fine (see above)."""
-    if not slow_against_nutation(values, m):  # on the answer's samples first: no finer grid for a refusal
-        return float("inf")
+def _enclosure(values: dict, g, own: dict, r: float, limit: float = np.inf):
+    """(the largest |P_level - P_full| over the horizon, the largest |G (s - s_l)|) with the
+    tube constants of radius r (see above); inf where the tube reaches +-90 deg, or where
+    |G (s - s_l)| reaches `limit` (the image point's error is at least that: rho^2 >= 1)."""
+    H0 = abs(float(values["H"]))
+    S = np.stack([g.alpha, g.beta, g.H], axis=-1)
+    cb = np.cos(g.beta)
+    if np.any(np.abs(g.beta) + r >= EDGE) or np.any(np.abs(g.alpha) + r / np.abs(cb) >= EDGE):
+        return float("inf"), float("inf")
+    Gd = np.stack([np.abs(cb), np.ones_like(cb), np.full_like(cb, 1 / H0)], axis=-1)
+    dl = _level_defect(values, g)
+    rate = own["Phi"] - dl  # the level's own rates, in alpha', beta', H'
+    Gdot = np.stack([-np.tan(g.beta) * rate[:, 1], np.zeros_like(cb), np.zeros_like(cb)], axis=-1)
+    kappa = np.einsum("nij,nj->ni", own["Dpi"], rate)  # the nutation centre's drift along the level
+    c = _over_tube(values, S, own, Gd, Gdot, kappa, r)
+    if not all(np.all(np.isfinite(x)) for x in c.values()) or not (np.all(c["mmin"] > 0) and np.all(c["Lpi"] < 1)):
+        return float("inf"), float("inf")
+    dn = np.linalg.norm(Gd * dl, axis=-1)
+    dstep = np.maximum(dn[:-1], dn[1:]) + np.abs(dn[1:] - dn[:-1])
+    h = np.diff(g.t)
+    W = float(np.sqrt(own["eta"][0] @ own["Mr"][0] @ own["eta"][0]))  # w(0) = 0 (full starts on (13)):
+    # om(0) = -eta(s(0)), the full state at t = 0 the level's; delta(0) = 0
+    E = worst = 0.0
+    k1 = 1 / (1 - c["Lpi"])
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused below, not warned
+        gl = np.exp(c["lam"] * h)
+        gm = np.exp((c["mu"] + c["L"] * c["Lpi"] * k1) * h)
+        for k in range(len(h)):
+            Wsup = (W + h[k] * c["rho"][k]) * max(1.0, gl[k])  # |w|_Mr over the step
+            W = W * gl[k] + h[k] * c["rho"][k] * max(1.0, gl[k])
+            wmax = c["eta"][k] + Wsup / np.sqrt(c["mmin"][k])  # |w| <= |eta| + |om| over the step
+            F = (c["L"][k] * c["PK"][k] * k1[k] * wmax + c["s1"][k] * wmax + c["s2"][k] * wmax**2 / 2
+                 + c["chi"][k] + dstep[k])
+            Esup = (E + h[k] * F) * max(1.0, gm[k])
+            E = E * gm[k] + h[k] * F * max(1.0, gm[k])
+            here = (Esup + c["PK"][k] * wmax) * k1[k]  # |G (s - s_l)| over the step
+            if not here < limit:  # an overflow (inf, or inf * 0), or past the limit: no enclosure worth offering
+                return float("inf"), float("inf")
+            worst = max(worst, here)
+    # the sphere's distance within max(1, cos beta / cos beta_l) |G e| over the tube, the image
+    # point within rho^2 of it (the gnomonic projection's largest scale), both largest over the tube
+    cos_b = np.cos(np.maximum(np.abs(g.beta) - worst, 0.0)) / np.abs(cb)
+    c_far = np.cos(np.abs(g.alpha) + worst / np.abs(cb)) * np.cos(np.abs(g.beta) + worst)
+    if np.any(c_far <= SINGULAR_COS) or np.any(np.abs(g.beta) + worst >= EDGE):
+        return float("inf"), worst
+    return float(np.max(np.maximum(1.0, cos_b) / c_far**2) * worst), worst
+
+
+def model_error(values: dict, m, limit: float = np.inf) -> float:
+    """The enclosure of the largest |P_level - P_full| over the horizon (absolute; the
+    derivation above); inf where the level refuses: the tube does not close within BOOTSTRAP
+    tries, reaches +-90 deg, or the grid would be too fine; inf also where a try's bound
+    reaches `limit` (a bound no use: the caller's relative bound would be >= 1)."""
     g = _bound_grid(values, m)
-    if g is None or not slow_against_nutation(values, g):
+    if g is None:
         return float("inf")
-    D = defect(values, g)
-    d = np.sqrt((np.cos(g.beta) * D[:, 0])**2 + D[:, 1]**2 + (D[:, 2] / abs(float(values["H"])))**2)
-    e = _carried(g.t, log_norm(values, g), d)
-    # the nutation the defect excites: a rate defect d moves the gyroscope on a cycloid about
-    # the drift d t, at most 2 |d|/omega_n off it, omega_n >= H |cos beta|/J
-    nutation = 2 * float(np.max(d)) * float(np.max(transverse_inertia(values) / np.abs(g.H * np.cos(g.beta))))
-    return float(np.max((1 + g.x**2 + g.y**2) * (e + nutation)))
+    own = _at(values, np.stack([g.alpha, g.beta, g.H], axis=-1))
+    r = 0.0
+    for _ in range(BOOTSTRAP):
+        err, worst = _enclosure(values, g, own, r, limit)
+        if not np.isfinite(worst):
+            return float("inf")
+        if worst < r:  # closed: the tube of radius r holds the full motion over the horizon
+            return err
+        r = TUBE_GROWTH * worst
+    return float("inf")
 
 
 def integration_error(values: dict, m) -> float:
@@ -689,7 +855,7 @@ def bound(values: dict, m) -> float:
     scale = _scale(m)
     if not scale > 0:
         return float("inf")
-    model = 0.0 if m.level == "full" else SAFETY * model_error(values, m)
+    model = 0.0 if m.level == "full" else model_error(values, m, limit=scale)
     if not model / scale < 1:  # no bound: the integrator's runs are not needed
         return float("inf")
     b = (model + integration_error(values, m)) / scale

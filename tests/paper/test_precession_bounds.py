@@ -109,8 +109,9 @@ def test_the_selectors_answer_is_within_the_tolerance(s, T, log_tol):
 
 def test_the_flat_ring_on_a_turning_base():
     """The issue's case: a flat outer ring (C2 - C1 = C3) on a base turning at u_zeta = 10
-    rad/s is past the precession levels' nutation edge (|u| J/(H cos beta0) = 0.13), so
-    `full` answers it; at 5 rad/s the levels answer, each within its bound: the ring's
+    rad/s: the precession levels' enclosure does not close there (the w energy's growth
+    exp(lambda T), lambda about |u|, over 2 s), so `full` answers it (the set is also past
+    the declared edge |u| J/(H cos beta0) = 0.13 >= 1/10); at 5 rad/s the levels answer, each within its bound: the ring's
     centrifugal moment (C2 - C1) w_eta1 w_zeta1 is in the bound's residual (the rigorous
     level errs 3.5e-4 on the flat ring and 2.5e-2 on the equal ring: the ring's moment
     there partly cancels the casing's inertia moments, and each bound holds its own)."""
@@ -124,8 +125,83 @@ def test_the_flat_ring_on_a_turning_base():
             assert (b == np.inf) == refused
             assert _error(m, ref) <= b
         if not refused:  # the ring's term is in full: its motion moves by 2.5e-2 of the excursion
-            # from the equal ring's (measured), over 10x the rigorous bound (1.2e-3) that holds on both
+            # from the equal ring's (measured), over the rigorous bound that holds on both (a bound
+            # without the ring's term would be beaten)
             v0, ref0 = _reference({**s, "C1": 2e-3, "C2": 2e-3}, t)
             m0 = pr.simulate(v0, t, "rigorous")
             assert _error(m0, ref0) <= pr.bound(v0, m0)
-            assert _error(ref, ref0) > 10 * pr.bound(v, pr.simulate(v, t, "rigorous"))
+            assert _error(ref, ref0) > pr.bound(v, pr.simulate(v, t, "rigorous"))  # 2.5e-2 against 5.8e-3
+
+
+# a set with every term of the proof on: friction in all three axes, a flat ring off its
+# defaults, a base turning about all three axes, moments on casing and rotor, the imbalance
+PROOF_SET = {"alpha0": 0.3, "beta0": -0.7, "H": 0.6, "u_xi": 0.4, "u_eta": -0.3, "u_zeta": 1.1, "f_alpha": 0.01,
+             "f_beta": 0.02, "f_phi": 0.003, "Mmotor": 0.002, "k_xi1": 3e-4, "l_x": 1e-3, "l_y": -2e-3, "l_z": 5e-4,
+             "m_z": -4e-4, "C1": 1e-3, "C2": 3e-3}
+
+
+def test_the_enclosures_identities_hold_on_the_full_equations():
+    """The derivation's steps (docs/precession.md, "The bound of each level"), checked on the
+    generated equations: hrest does not contain H; Kg f = cg is (13); sigma and the energy of
+    om are polynomials of degree 2 (no cubic term, so the Hessian at 0 is the whole quadratic
+    part); and along a run of `full` (its own state and rates) the slow variable z = s + B Kg^-1
+    Mr v moves at Phi(s) + sigma(s, v), the energy of om = w - eta at -om.rho1 + om.Q om."""
+    import casadi as ca
+
+    v = pr.parameters(PROOF_SET)
+    P = pr.vector(v)
+    p, s, vv, _, hrest, _, _, _ = pr._split()
+    rng = np.random.default_rng(3)
+    S = np.stack([rng.uniform(-1, 1, 5), rng.uniform(-1.2, 1.2, 5), rng.uniform(0.3, 2, 5)])
+    V = rng.uniform(-3, 3, (2, 5))
+    dH = ca.Function("dH", [p, s, vv], [ca.jacobian(hrest, s[2])])
+    assert np.abs(np.array(dH(P, S, V))).max() < 1e-13
+    c = pr._at(v, S.T)
+    assert np.allclose(c["Phi"], pr._rigorous(P, *S), rtol=1e-12, atol=1e-15)
+    e = pr._expressions()
+    for expr, var in ((e["sigma"], e["w"]), (e["energy"], e["o"])):  # degree 2: the third derivatives vanish
+        third = ca.jacobian(ca.vec(ca.jacobian(ca.jacobian(expr, var), var)), var)
+        fun = ca.Function("third", [e["p"], e["s"], var], [third])
+        assert np.abs(np.array(fun(P, S[:, 0], [0.3, -0.2]))).max() < 1e-10
+
+    # along full: its state (alpha, beta, phi, rates) at 2001 times over 0.02 s (the nutation at
+    # H/J, ~60 rad/s here, resolved: h = 1e-5 s). Measured: z' agrees to 1e-9 of its size (without
+    # sigma 3e-2), the energy's rate to 1e-6 (without Q 0.63): the tolerances are the central
+    # differences' truncation (h omega)^2/6 ~ 6e-8 of the rates, with room for the stiffer sets
+    # a change of PROOF_SET may bring
+    T, n = 0.02, 2001
+    grid = tuple(np.linspace(0.0, 1.0, n)[1:])
+    Fi = pr._integrator("full", grid, pr._steps("full", n), 0.01, "bdf")
+    y0 = pr.initial_state("full", v)
+    Y = np.vstack([y0, np.array(Fi(x0=y0, p=np.append(P, T))["xf"]).T])
+    t = np.linspace(0.0, T, n)
+    nf = load(pr.MODEL).numpy
+    Hf = nf.rotor_momentum(P, Y[:, :3], Y[:, 3:])[:, 0]
+    Sf = np.stack([Y[:, 0], Y[:, 1], Hf], axis=-1)
+    vf = Y[:, 3:5]
+    cf = pr._at(v, Sf)
+    wf = vf - cf["Phi"][:, :2]
+    z = Sf + np.einsum("nij,nj->ni", cf["BKM"], vf)
+    sig_f = (cf["sigma"] + np.einsum("nij,nj->ni", cf["s1"], wf)
+             + 0.5 * np.einsum("nijk,nj,nk->ni", cf["s2"], wf, wf))
+    zdot = np.gradient(z, t, axis=0, edge_order=2)[5:-5]
+    want = (cf["Phi"] + sig_f)[5:-5]
+    scale = np.abs(want).max(axis=0)
+    assert np.all(np.abs(zdot - want).max(axis=0) <= 1e-5 * scale + 1e-12), np.abs(zdot - want).max(axis=0) / scale
+    om = wf - cf["eta"]
+    energy = 0.5 * np.einsum("ni,nij,nj->n", om, cf["Mr"], om)
+    edot = np.gradient(energy, t, edge_order=2)[5:-5]
+    want = (-np.einsum("ni,ni->n", om, cf["rho1"]) + np.einsum("ni,nij,nj->n", om, cf["Q"], om))[5:-5]
+    assert np.abs(edot - want).max() <= 1e-4 * np.abs(want).max()
+
+
+def test_the_enclosure_is_tight_where_the_first_order_term_dominates():
+    """The issue's beta0 = 1.45 (10 s, sec(beta) = 8.4): `rigorous` errs 1.13e-4; the
+    enclosure is 1.16e-4 (the first-order defect exactly, carried on the sphere, the
+    remainders second order); the estimate before it offered twice the first-order term,
+    2.3e-4. Not above 1.5x the error, so the proof costs no usefulness here."""
+    t = np.linspace(0.0, 10.0, 201)
+    v, ref = _reference({"beta0": 1.45}, t)
+    m = pr.simulate(v, t, "rigorous")
+    err, b = _error(m, ref), pr.bound(v, m)
+    assert err <= b <= 1.5 * err, (err, b)

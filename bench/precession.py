@@ -153,10 +153,11 @@ def main() -> int:
     import sys
 
     RESULTS.mkdir(exist_ok=True)
-    if sys.argv[1:] == ["--maps"]:  # the costs and the maps alone, into the committed results
+    if sys.argv[1:] in (["--maps"], ["--costs"]):  # the costs (and the maps) alone, into the committed results
         data = json.loads((RESULTS / "precession.json").read_text())
         data["costs"] = costs()
-        data["maps"] = maps()
+        if sys.argv[1:] == ["--maps"]:
+            data["maps"] = maps()
         (RESULTS / "precession.json").write_text(json.dumps(data, indent=1, allow_nan=False) + "\n")
         return 0
     data = {"machine": {"cores": 2, "processor": platform.processor(), "python": platform.python_version()},

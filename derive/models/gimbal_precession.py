@@ -348,16 +348,16 @@ def quantities():
     }
 
 
-# seconds per set for a 10 s horizon, 201 points, with the bound (bench/precession.py,
-# bench/results/precession.json "costs": the median CPU time of the evaluator). The four
-# precession levels measured 5.3-6.3 ms, equal within the run's spread (CVODES' overhead
-# dominates their small right-hand sides; the bound's BDF run, its looser Adams run and its
-# defect on the unit sphere are 4/5 of it): each is declared at their common median, so
-# that the declared order, simplest first, breaks the tie; full measured 0.48 s (the answer
-# and the bound's two runs).
-PRECESSION_COST = 0.00586
+# seconds per set for a 10 s horizon, 201 points, with the bound (bench/precession.py
+# --costs, bench/results/precession.json "costs": the median CPU time of the evaluator). The
+# four precession levels measured 15.8-17.7 ms, equal within the run's spread (the
+# enclosure's constants along the motion, by CasADi's derivatives, and the bound's BDF and
+# looser Adams runs are most of it): each is declared at their common median, so that the
+# declared order, simplest first, breaks the tie; full measured 0.41 s (the answer and the
+# bound's two runs).
+PRECESSION_COST = 0.0167
 COSTS = {"elementary": PRECESSION_COST, "small": PRECESSION_COST, "rigorous": PRECESSION_COST,
-         "image": PRECESSION_COST, "full": 0.48}
+         "image": PRECESSION_COST, "full": 0.412}
 NEGLECTS = {
     "full": "nothing of the three bodies' Lagrange equations (the integrator's truncation)",
     "rigorous": "the rings' momenta and the rotor's transverse momentum: H along z' only (6)",
@@ -370,17 +370,16 @@ NEGLECTS = {
 
 def levels():
     """The five levels (docs/precession.md): each answers the motion of the image point over
-    a horizon, its bound the level's own estimate along its motion (gyro.systems.gimbal_precession:
-    the neglected moments integrated, twice, and the integrator's), edges the singular
-    casing angle."""
+    a horizon, its bound the level's own along its motion (gyro.systems.gimbal_precession: an
+    enclosure of the neglected terms from the full equations, docs/precession.md, and the
+    integrator's), edges the singular casing angle."""
     from derive.model import Bound, Level
 
     valid = {"|beta0| < 90 deg (13) regular": sp.cos(beta0) - sp.Rational(1, 1000),
              "|alpha0| < 90 deg (the image point in the plane)": sp.cos(alpha0) - sp.Rational(1, 1000)}
     # the precession is the slow motion only while the base turns slowly against the nutation,
     # whose frequency is at least H |cos beta|/J (J every moment besides the rotor's momentum):
-    # the runtime holds the same ratio along the motion with the frames' own rates added
-    # (gyro.systems.gimbal_precession.NUTATION_RATIO)
+    # an a-priori edge; the enclosure itself refuses where its tube does not close
     J = C1 + C2 + C3 + B1 + B2 + B3 + 2 * A1 + A3
     slow = {**valid, "|u| J/(H cos beta0) < 1/10 (the base slow against the nutation)":
             H * sp.Abs(sp.cos(beta0)) / 10 - sp.sqrt(u_xi**2 + u_eta**2 + u_zeta**2) * J}

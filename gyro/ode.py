@@ -6,11 +6,13 @@ forced response's shooting) and of the tests that integrate a model.
 `symbolic(model)` gives the CasADi expressions (for Jacobians, substitutions and
 integrators); `rhs(model)` a compiled CasADi Function rhs(y, p, *inputs) -> y', where the
 inputs are the forcing's own after (params, q, qd) in the emitted order (the torsion
-gyrocompass's given forces and their rates). Called from NumPy it costs about a seventh of
-the emitted NumPy functions' per-call overhead on the 11-coordinate model."""
+gyrocompass's given forces and their rates). `numpy_rhs` (SciPy's methods) calls it as C
+(`compiled_rhs`: CasADi's code generator, compiled once per machine): 2.2 us a call on the
+11-coordinate model against 82 us through the CasADi Function, the same bits."""
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -116,19 +118,100 @@ def rhs(model: Model, varying: bool = False):
 def numpy_rhs(model: Model, P, inputs=None):
     """y -> y' (a NumPy vector) at fixed parameters P, and the forcing's further inputs as
     a function of t (inputs(t) -> a tuple of vectors; zeros where None): the form SciPy's
-    solve_ivp takes, fun(t, y)."""
+    solve_ivp takes, fun(t, y). Through `compiled_rhs` where there is a compiler (the same
+    operations, the same bits), through the CasADi Function otherwise."""
+    s = symbolic(model)
+    zeros = tuple(np.zeros(v.numel()) for v in s.inputs)
+    compiled = compiled_rhs(model)
+    if compiled is not None:
+        return compiled.bind(np.asarray(P, float), zeros, inputs)
     import casadi as ca
 
     F = rhs(model)
     Pd = ca.DM(np.asarray(P, float))
-    s = symbolic(model)
-    zeros = tuple(np.zeros(v.numel()) for v in s.inputs)
 
     def fun(t, y):
         extra = zeros if inputs is None else inputs(t)
         return np.asarray(F(y, Pd, *extra)).ravel()
 
     return fun
+
+
+class CompiledRhs:
+    """`rhs(model)` as C: CasADi's code generator writes the Function's own operations, and
+    gyro.cbackend compiles them once per machine (cached like the model's C). A call from
+    SciPy then costs the C and a few copies, not CasADi's argument conversions: on the torsion
+    gyrocompass 159 -> 75 us through ca.external, ~10 us this way (its 1 s motion at rtol 1e-9
+    and 1e-11 takes 282,549 calls)."""
+
+    def __init__(self, F, lib):
+        import ctypes
+
+        self.fn = lib.rhs
+        self.fn.restype = ctypes.c_int
+        self.n_in = F.n_in()
+        self.sizes = [F.nnz_in(i) for i in range(self.n_in)]
+        self.n_out = F.nnz_out(0)
+        self.sz_arg, self.sz_res, self.sz_iw, self.sz_w = F.sz_arg(), F.sz_res(), F.sz_iw(), F.sz_w()
+
+    def bind(self, P, zeros, inputs):
+        """fun(t, y) at the parameters P, the further inputs zeros or inputs(t)."""
+        import ctypes
+
+        bufs = [np.zeros(k) for k in self.sizes]
+        bufs[1][:] = P
+        out = np.zeros(self.n_out)
+        iw = np.zeros(max(self.sz_iw, 1), dtype=np.int64)
+        w = np.zeros(max(self.sz_w, 1))
+        arg = (ctypes.c_void_p * max(self.sz_arg, 1))(*[b.ctypes.data for b in bufs])
+        res = (ctypes.c_void_p * max(self.sz_res, 1))(out.ctypes.data)
+        iw_p, w_p, fn = iw.ctypes.data_as(ctypes.c_void_p), w.ctypes.data_as(ctypes.c_void_p), self.fn
+        for b, z in zip(bufs[2:], zeros):
+            b[:] = z
+        y_buf = bufs[0]
+
+        def fun(t, y):
+            y_buf[:] = y
+            if inputs is not None:
+                for b, v in zip(bufs[2:], inputs(t)):
+                    b[:] = v
+            if fn(arg, res, iw_p, w_p, 0):
+                raise ArithmeticError("the compiled equations of motion failed")
+            return out.copy()
+
+        return fun
+
+
+def compiled_rhs(model: Model) -> CompiledRhs | None:
+    """The model's `rhs` compiled (cached per model and, as C, per machine); None without a
+    compiler or where the build fails, so that the caller takes the CasADi Function."""
+    key = _key(model, "compiled_rhs")
+    if key not in _CACHE:
+        import hashlib
+
+        from gyro import cbackend
+
+        F = rhs(model)
+        try:
+            cbackend._available()
+            import casadi as ca
+
+            cg = ca.CodeGenerator("rhs", {"with_header": False, "casadi_int": "long long int"})
+            cg.add(F)
+            text = cg.dump()
+            digest = hashlib.sha256(text.encode()).hexdigest()[:16]
+            src = cbackend._writable_cache() / "rhs-sources" / f"rhs-{digest}.c"
+            if not src.exists() or src.read_text() != text:
+                src.parent.mkdir(parents=True, exist_ok=True)
+                tmp = src.with_suffix(f".{os.getpid()}.tmp")
+                tmp.write_text(text)
+                os.replace(tmp, src)  # atomic: another process may write the same bytes
+            lib = cbackend._shared(f"rhs-{digest}", (src,), (),
+                                   notice=f"the generated C of {model.name}'s equations of motion")
+            _CACHE[key] = CompiledRhs(F, lib)
+        except cbackend.CompilerUnavailable:
+            _CACHE[key] = None
+    return _CACHE[key]
 
 
 def jacobian(model: Model):

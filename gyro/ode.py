@@ -7,7 +7,7 @@ forced response's shooting) and of the tests that integrate a model.
 integrators); `rhs(model)` a compiled CasADi Function rhs(y, p, *inputs) -> y', where the
 inputs are the forcing's own after (params, q, qd) in the emitted order (the torsion
 gyrocompass's given forces and their rates). `numpy_rhs` (SciPy's methods) calls it as C
-(`compiled_rhs`: CasADi's code generator, compiled once per machine): 2.2 us a call on the
+(`compiled`: CasADi's code generator, compiled once per machine): 2.2 us a call on the
 11-coordinate model against 82 us through the CasADi Function, the same bits."""
 from __future__ import annotations
 
@@ -118,13 +118,27 @@ def rhs(model: Model, varying: bool = False):
 def numpy_rhs(model: Model, P, inputs=None):
     """y -> y' (a NumPy vector) at fixed parameters P, and the forcing's further inputs as
     a function of t (inputs(t) -> a tuple of vectors; zeros where None): the form SciPy's
-    solve_ivp takes, fun(t, y). Through `compiled_rhs` where there is a compiler (the same
-    operations, the same bits), through the CasADi Function otherwise."""
+    solve_ivp takes, fun(t, y). Through `compiled(model, "rhs")` where there is a compiler
+    (the same operations, the same bits), through the CasADi Function otherwise."""
     s = symbolic(model)
     zeros = tuple(np.zeros(v.numel()) for v in s.inputs)
-    compiled = compiled_rhs(model)
-    if compiled is not None:
-        return compiled.bind(np.asarray(P, float), zeros, inputs)
+    c = compiled(model, "rhs")
+    if c is not None:
+        ins, (out,), call = c.buffers()
+        y_buf, p_buf, extra_bufs = ins[0], ins[1], ins[2:]
+        p_buf[:] = P
+        for b, z in zip(extra_bufs, zeros):
+            b[:] = z
+
+        def fun(t, y):
+            y_buf[:] = y
+            if inputs is not None:
+                for b, v in zip(extra_bufs, inputs(t)):
+                    b[:] = v
+            call()
+            return out.copy()
+
+        return fun
     import casadi as ca
 
     F = rhs(model)
@@ -137,78 +151,77 @@ def numpy_rhs(model: Model, P, inputs=None):
     return fun
 
 
-class CompiledRhs:
-    """`rhs(model)` as C: CasADi's code generator writes the Function's own operations, and
-    gyro.cbackend compiles them once per machine (cached like the model's C). A call from
-    SciPy then costs the C and a few copies, not CasADi's argument conversions: on the torsion
-    gyrocompass 159 -> 75 us through ca.external, ~10 us this way (its 1 s motion at rtol 1e-9
-    and 1e-11 takes 282,549 calls)."""
+class Compiled:
+    """A CasADi Function of this module (`rhs`, `variational`) as C: CasADi's code generator
+    writes the Function's own operations, gyro.cbackend compiles them once per machine
+    (content-addressed, cached like the model's C). A call from SciPy then costs the C and a
+    few copies, not CasADi's argument conversions: on the torsion gyrocompass's right-hand
+    side 82 us through the Function, 2.2 us this way (its 1 s motion at rtol 1e-9 and 1e-11
+    takes 282,549 calls)."""
 
     def __init__(self, F, lib):
         import ctypes
 
-        self.fn = lib.rhs
+        self.fn = getattr(lib, F.name())
         self.fn.restype = ctypes.c_int
-        self.n_in = F.n_in()
-        self.sizes = [F.nnz_in(i) for i in range(self.n_in)]
-        self.n_out = F.nnz_out(0)
-        self.sz_arg, self.sz_res, self.sz_iw, self.sz_w = F.sz_arg(), F.sz_res(), F.sz_iw(), F.sz_w()
+        self.sizes_in = [F.nnz_in(i) for i in range(F.n_in())]
+        self.sizes_out = [F.nnz_out(i) for i in range(F.n_out())]
+        self.sz = (F.sz_arg(), F.sz_res(), F.sz_iw(), F.sz_w())
 
-    def bind(self, P, zeros, inputs):
-        """fun(t, y) at the parameters P, the further inputs zeros or inputs(t)."""
+    def buffers(self):
+        """(inputs, outputs, call): arrays of the Function's nonzeros (dense matrices column
+        by column, as CasADi orders them) bound to one C call; call() fills the outputs."""
         import ctypes
 
-        bufs = [np.zeros(k) for k in self.sizes]
-        bufs[1][:] = P
-        out = np.zeros(self.n_out)
-        iw = np.zeros(max(self.sz_iw, 1), dtype=np.int64)
-        w = np.zeros(max(self.sz_w, 1))
-        arg = (ctypes.c_void_p * max(self.sz_arg, 1))(*[b.ctypes.data for b in bufs])
-        res = (ctypes.c_void_p * max(self.sz_res, 1))(out.ctypes.data)
+        ins = [np.zeros(k) for k in self.sizes_in]
+        outs = [np.zeros(k) for k in self.sizes_out]
+        sz_arg, sz_res, sz_iw, sz_w = (max(k, 1) for k in self.sz)
+        iw, w = np.zeros(sz_iw, dtype=np.int64), np.zeros(sz_w)
+        arg = (ctypes.c_void_p * max(sz_arg, len(ins)))(*[b.ctypes.data for b in ins])
+        res = (ctypes.c_void_p * max(sz_res, len(outs)))(*[b.ctypes.data for b in outs])
         iw_p, w_p, fn = iw.ctypes.data_as(ctypes.c_void_p), w.ctypes.data_as(ctypes.c_void_p), self.fn
-        for b, z in zip(bufs[2:], zeros):
-            b[:] = z
-        y_buf = bufs[0]
+        keep = (ins, outs, iw, w, arg, res)
 
-        def fun(t, y):
-            y_buf[:] = y
-            if inputs is not None:
-                for b, v in zip(bufs[2:], inputs(t)):
-                    b[:] = v
+        def call():
             if fn(arg, res, iw_p, w_p, 0):
                 raise ArithmeticError("the compiled equations of motion failed")
-            return out.copy()
+            return keep
 
-        return fun
+        return ins, outs, call
 
 
-def compiled_rhs(model: Model) -> CompiledRhs | None:
-    """The model's `rhs` compiled (cached per model and, as C, per machine); None without a
-    compiler or where the build fails, so that the caller takes the CasADi Function."""
-    key = _key(model, "compiled_rhs")
+def compiled(model: Model, what: str) -> Compiled | None:
+    """`rhs(model)` or `variational(model)` compiled (cached per model and, as C, per
+    machine); None without a compiler or where the build fails, so that the caller takes
+    the CasADi Function."""
+    key = _key(model, "compiled_" + what)
     if key not in _CACHE:
         import hashlib
 
         from gyro import cbackend
 
-        F = rhs(model)
+        F = {"rhs": rhs, "variational": variational}[what](model)
         try:
             cbackend._available()
             import casadi as ca
 
-            cg = ca.CodeGenerator("rhs", {"with_header": False, "casadi_int": "long long int"})
+            cg = ca.CodeGenerator(what, {"with_header": False, "casadi_int": "long long int"})
             cg.add(F)
             text = cg.dump()
             digest = hashlib.sha256(text.encode()).hexdigest()[:16]
-            src = cbackend._writable_cache() / "rhs-sources" / f"rhs-{digest}.c"
+            src = cbackend._writable_cache() / "casadi-sources" / f"{what}-{digest}.c"
             if not src.exists() or src.read_text() != text:
                 src.parent.mkdir(parents=True, exist_ok=True)
                 tmp = src.with_suffix(f".{os.getpid()}.tmp")
                 tmp.write_text(text)
                 os.replace(tmp, src)  # atomic: another process may write the same bytes
-            lib = cbackend._shared(f"rhs-{digest}", (src,), (),
-                                   notice=f"the generated C of {model.name}'s equations of motion")
-            _CACHE[key] = CompiledRhs(F, lib)
+            label = {"rhs": "equations of motion", "variational": "variational equations"}[what]
+            # -O1 after the flags' -O3: CasADi's straight-line code gains nothing from -O3
+            # (the torsion gyrocompass's variational equations, 2 MB of C: 23 us a call at -O1,
+            # 22 us at -O3), whose compile takes 80 s there against 8 s
+            lib = cbackend._shared(f"{what}-{digest}", (src,), (), ("-O1",),
+                                   notice=f"the generated C of {model.name}'s {label}")
+            _CACHE[key] = Compiled(F, lib)
         except cbackend.CompilerUnavailable:
             _CACHE[key] = None
     return _CACHE[key]
@@ -249,11 +262,29 @@ def numpy_variational(model: Model, P, inputs=None):
     further inputs a function of t as in `numpy_rhs`. Returns (fun, n), n the state's size."""
     import casadi as ca
 
-    F = variational(model)
-    Pd = ca.DM(np.asarray(P, float))
     s = symbolic(model)
     n = s.y.numel()
     zeros = tuple(np.zeros(v.numel()) for v in s.inputs)
+    c = compiled(model, "variational")
+    if c is not None:  # the same operations as the Function below, in C
+        ins, (yd, phid), call = c.buffers()
+        y_buf, phi_buf, p_buf, extra_bufs = ins[0], ins[1], ins[2], ins[3:]
+        p_buf[:] = P
+        for b, z in zip(extra_bufs, zeros):
+            b[:] = z
+
+        def fun_c(t, Y):
+            y_buf[:] = Y[:n]
+            phi_buf[:] = Y[n:]  # Phi column-major: CasADi's order of a dense matrix's nonzeros
+            if inputs is not None:
+                for b, v in zip(extra_bufs, inputs(t)):
+                    b[:] = v
+            call()
+            return np.concatenate([yd, phid])
+
+        return fun_c, n
+    F = variational(model)
+    Pd = ca.DM(np.asarray(P, float))
 
     def fun(t, Y):
         extra = zeros if inputs is None else inputs(t)

@@ -153,4 +153,9 @@ def test_a_parameter_typed_by_its_alias_is_the_same_parameter():
 def test_an_unknown_level_lists_each_known_one_once(tmp_path):
     rc, _, err = run_cli("level-map", "gimbal_precession", "--level", "nosuch", "--against", "small",
                          "--x", "k_xi1=0:1e-4:2", "--y", "l_x=5e-4:1e-3:2", "--out", str(tmp_path / "m.png"))
-    assert rc == 2 and err.strip().endswith("known: elementary, small, rigorous, image, full"), err
+    assert rc == 2 and err.count("\n") == 1, err
+    known = err.strip().split("known: ")[1].split(", ")
+    assert len(known) == len(set(known)), known
+    # its own five in its order, and the exact operator's levels every model with one has
+    assert [k for k in known if not k.startswith("linear_exact")] == ["elementary", "small", "rigorous", "image", "full"]
+    assert "linear_exact:default" in known

@@ -249,8 +249,8 @@ def _source_root() -> Path | None:
 
 def model_key(path: Path, root: Path) -> str:
     """The hash of everything a derivation of the model file `path` reads: the file (or the
-    model folder's Python files) and the Python files beside it (a model file may import
-    them), the machinery (derive/, templates/) and the versions of the symbolic tools."""
+    model folder's Python files), the Python files beside it and in the packages beside it
+    (a model file may import them), the machinery (derive/, templates/) and the versions of the symbolic tools."""
     import hashlib
     from importlib.metadata import PackageNotFoundError, version
 
@@ -258,6 +258,11 @@ def model_key(path: Path, root: Path) -> str:
     path = path.resolve()
     own = sorted(path.glob("*.py")) if path.is_dir() else [path] + sorted(
         p for p in path.parent.glob("*.py") if p != path)
+    # and the packages beside it (a folder with an __init__.py a model file may import from):
+    # every Python file in them, as the emitter's input hash has every module imported
+    home = path if path.is_dir() else path.parent
+    own += sorted(p for d in sorted(home.iterdir()) if d.is_dir() and (d / "__init__.py").is_file()
+                  for p in d.rglob("*.py") if "__pycache__" not in p.parts)
     machinery = sorted(p for p in (root / "derive").rglob("*.py") if "__pycache__" not in p.parts)
     machinery += sorted(p for p in (root / "templates").iterdir() if p.is_file())
     for p in own + machinery:

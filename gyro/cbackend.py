@@ -332,6 +332,33 @@ def qep_refine(model_name: str) -> QepRefine:
     return _built(QepRefine, model_name)
 
 
+class QepMoves:
+    """The operator's own rounding carried into each root (gyro/csrc/qep.c
+    gyro_qep_moves_batch; gyro.qep.hermitian_moves in C)."""
+
+    def __init__(self, model_name: str):
+        self._fn, self.n, _ = _qep_kernel(model_name, "gyro_qep_moves_batch")
+
+    def __call__(self, moves, M, D, w, z):
+        dM, dD, dK = moves
+        M, D, dM, dD, dK = (np.ascontiguousarray(X, dtype=float) for X in (M, D, dM, dD, dK))
+        w = np.ascontiguousarray(w, dtype=float)
+        z = np.ascontiguousarray(z, dtype=complex)
+        _check(all(X.shape == (w.shape[0], self.n, self.n) for X in (M, D, dM, dD, dK)) and w.ndim == 2
+               and z.shape == w.shape + (self.n,), f"M, D, dM, dD, dK must be (sets, {self.n}, {self.n}), "
+               "w (sets, roots) and z (sets, roots, n)")
+        out = np.empty(w.shape)
+        ptr = ctypes.POINTER(ctypes.c_double)
+        self._fn(ctypes.c_long(w.shape[0]), ctypes.c_long(w.shape[1]),
+                 *[a.ctypes.data_as(ptr) for a in (M, D, dM, dD, dK, w, z, out)])
+        return out
+
+
+def qep_moves(model_name: str) -> QepMoves:
+    """The compiled contraction of the operator's rounding (CompilerUnavailable without it)."""
+    return _built(QepMoves, model_name)
+
+
 class QepHermitian:
     """The Hermitian form of a diagonal block of the operator (gyro/csrc/qep.c;
     gyro.qep.hermitian_block's matrix T, in C)."""

@@ -375,11 +375,16 @@ def equilibrium_moves(model: Model, P, qe, M, D, K):
     return tuple(out)
 
 
-def hermitian_moves(moves, M, D, w, z) -> np.ndarray:
+def hermitian_moves(moves, M, D, w, z, model: Model | None = None) -> np.ndarray:
     """Each root's move, relative, under an entrywise change |dM|, |dD|, |dK| of a
     gyroscopic operator, to first order from its vector z (B, r, n): the Rayleigh functional
     a w^2 + beta w - c moves by at most |z|^T (w^2 |dM| + w |dD| + |dK|) |z|, the root by
-    that over |2 a w + beta| (gyro.qep.rayleigh_step's estimate, with |dJ| for eps |J|)."""
+    that over |2 a w + beta| (gyro.qep.rayleigh_step's estimate, with |dJ| for eps |J|).
+    Compiled (gyro/csrc/qep.c) where there is a compiler, this NumPy otherwise."""
+    if model is not None:
+        kernel = compiled(cbackend.qep_moves, model)
+        if kernel is not None:
+            return kernel(moves, M, D, w, z)
     dM, dD, dK = moves
     x, y = np.ascontiguousarray(z.real), np.ascontiguousarray(z.imag)  # (B, r, n)
     az = np.abs(z)

@@ -31,6 +31,13 @@ void gyro_qep_refine_batch(long nsets, long r, long iters, double tol, const int
                            const double *M, const double *D, const double *K,
                            double *w, double *z, double *est, double *ok);
 
+/* The operator's own rounding carried into each root to first order (gyro.qep.hermitian_moves):
+   M, D, dM, dD, dK (nsets, n, n); w (nsets, r); z (nsets, r, n) complex, interleaved; out
+   (nsets, r). */
+void gyro_qep_moves_batch(long nsets, long r, const double *M, const double *D, const double *dM,
+                          const double *dD, const double *dK, const double *w, const double *z,
+                          double *out);
+
 /* The Hermitian form T (nsets, 2nb, 2nb; complex) of the diagonal block idx[nb] of each
  * operator, whose eigenvalues are 1/w; ok[nsets]: 1 where K and M of the block are
  * positive definite with a margin (qep.c). */

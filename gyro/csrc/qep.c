@@ -383,3 +383,46 @@ void gyro_qep_hermitian_batch(long nsets, long nb, const long *idx, const double
         }
     }
 }
+
+/* The operator's own rounding carried into each root (gyro.qep.hermitian_moves): for root j
+   of set k, with its unit vector z (interleaved complex) and frequency w,
+   |z|^T (w^2 |dM| + |w| |dD| + |dK|) |z| / (|2 a w + beta| w), a = z* M z (M symmetric),
+   beta = Im z* D z = 2 x^T D y (D skew, z = x + i y); the changes dM, dD, dK are entrywise
+   absolute values. inf where the quotient is not finite. */
+void gyro_qep_moves_batch(long nsets, long r, const double *M, const double *D, const double *dM,
+                          const double *dD, const double *dK, const double *w, const double *z,
+                          double *out)
+{
+    const long nn = (long)QEP_N * QEP_N;
+    for (long k = 0; k < nsets; ++k) {
+        const double *Mk = M + k * nn, *Dk = D + k * nn;
+        const double *dMk = dM + k * nn, *dDk = dD + k * nn, *dKk = dK + k * nn;
+        for (long j = 0; j < r; ++j) {
+            const double wj = w[k * r + j];
+            const double *zj = z + 2 * (k * r + j) * QEP_N;
+            double az[QEP_N], x[QEP_N], y[QEP_N];
+            for (int i = 0; i < QEP_N; ++i) {
+                x[i] = zj[2 * i];
+                y[i] = zj[2 * i + 1];
+                az[i] = sqrt(x[i] * x[i] + y[i] * y[i]);  /* z is a unit vector: no overflow */
+            }
+            double num = 0.0, a = 0.0, beta = 0.0;
+            for (int i = 0; i < QEP_N; ++i) {
+                double gk = 0.0, gm = 0.0, gd = 0.0, mx = 0.0, my = 0.0, dy = 0.0;
+                for (int l = 0; l < QEP_N; ++l) {
+                    gk += dKk[i * QEP_N + l] * az[l];
+                    gm += dMk[i * QEP_N + l] * az[l];
+                    gd += dDk[i * QEP_N + l] * az[l];
+                    mx += Mk[i * QEP_N + l] * x[l];
+                    my += Mk[i * QEP_N + l] * y[l];
+                    dy += Dk[i * QEP_N + l] * y[l];
+                }
+                num += az[i] * (gk + wj * wj * gm + fabs(wj) * gd);
+                a += x[i] * mx + y[i] * my;
+                beta += 2.0 * x[i] * dy;
+            }
+            const double q = num / (fabs(2.0 * a * wj + beta) * wj);
+            out[k * r + j] = isfinite(q) ? q : INFINITY;
+        }
+    }
+}

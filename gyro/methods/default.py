@@ -57,7 +57,7 @@ def solve(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
         take = slice(None) if h.size == N else h
         Mh, Dh, Kh = M[take], D[take], K[take]
         w, z, e, fine = qep.rayleigh(model, Mh, Dh, Kh, w0, z0, 3, tol, overwrite=True)  # the starts' own arrays
-        e = e + qep.hermitian_moves(tuple(X[take] for X in moves), Mh, Dh, w, z)
+        e = e + qep.hermitian_moves(tuple(X[take] for X in moves), Mh, Dh, w, z, model)
         ws_sorted = np.sort(w, axis=1)
         distinct = np.all(np.diff(ws_sorted, axis=1) > 1e-8 * ws_sorted[:, 1:], axis=1)
         # a root far below the others (omega1 -> 0 toward the pole or as u -> 0) carries the

@@ -55,3 +55,27 @@ def test_the_operators_rounding_is_small_where_nothing_amplifies_it(ghc):
     for d, X in zip(moves, (M, D, K)):
         nz = X != 0
         assert np.all(d[nz] <= 64 * qep.EPS * np.abs(X[nz])) and np.all(d[~nz] == 0)
+
+
+def test_the_compiled_contraction_is_the_numpy_one(ghc):
+    """gyro/csrc/qep.c's gyro_qep_moves_batch against gyro.qep.hermitian_moves in NumPy, on
+    the torsion gyrocompass's and the gyrohorizoncompass's own roots and vectors (one
+    Rayleigh step from the default method's frequencies): the same sums in another order,
+    so equal to a few eps of the largest term (measured 1e-15; 1e-13 allows the
+    denominator's cancellation where a root's 2 a w + beta is small)."""
+    from gyro import qep
+    from gyro.equilibrium import equilibria, operators
+
+    for m in (ghc, load("torsion_gyrocompass")):
+        P = np.tile(m.vector(), (40, 1)) * np.exp(np.random.default_rng(0).uniform(-0.1, 0.1, (40, len(m.param_names))))
+        qe, _ = equilibria(m, P)
+        M, D, K = operators(m, P, qe)
+        w0 = ladder.spectrum(m, P, "default").frequencies
+        z0 = np.ones(w0.shape + (M.shape[-1],), complex) / np.sqrt(M.shape[-1])
+        w, z, _, ok = qep.rayleigh_step(M, D, K, w0, z0)
+        assert ok.all()
+        moves = qep.equilibrium_moves(m, P, qe, M, D, K)
+        numpy_side = qep.hermitian_moves(moves, M, D, w, z)
+        c_side = qep.hermitian_moves(moves, M, D, w, z, m)
+        assert np.all(np.isfinite(numpy_side))
+        assert np.allclose(c_side, numpy_side, rtol=1e-13, atol=0), np.max(np.abs(c_side / numpy_side - 1))

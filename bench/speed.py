@@ -85,6 +85,8 @@ def measure(sets: int = 20000, repeats: int = 5) -> dict:
     import scipy.linalg as sla
 
     fl = floors(M, D, K, w0)
+    moves = qep.equilibrium_moves(MODEL, P, qe, M, D, K)
+    w_ref, z_ref, _, _ = qep.rayleigh(MODEL, M, D, K, w0, z0, 3, ladder.DEFAULT_TOL)
     tasks = {
         "default": (lambda: ladder.spectrum(MODEL, P, "default"), sets),
         "formulas": (lambda: ladder.spectrum(MODEL, P, "formulas"), sets),
@@ -96,6 +98,10 @@ def measure(sets: int = 20000, repeats: int = 5) -> dict:
             lambda: qep.block_starts(MODEL, M, D, K, ok), sets),
         "piece: refinement (<= 3 steps, to 1e-10)": (
             lambda: qep.rayleigh(MODEL, M, D, K, w0, z0, 3, ladder.DEFAULT_TOL), sets),
+        "piece: the operator's rounding (two probes)": (
+            lambda: qep.equilibrium_moves(MODEL, P, qe, M, D, K), sets),
+        "piece: its contraction into the roots (C)": (
+            lambda: qep.hermitian_moves(moves, M, D, w_ref, z_ref, MODEL), sets),
         "before: starts by the block forms and LAPACK eigvalsh": (
             lambda: [np.linalg.eigvalsh(kern(M, D, K, b)[0]) for b in blocks], sets),
         "before: refinement from one shared start vector": (

@@ -272,7 +272,7 @@ def certificate_cost(level, idx) -> float:
     return OPERATOR_COST + COUNT_COST * (1 + 2 * len(idx))
 
 
-def counts_below(M, D, K, w) -> np.ndarray:
+def counts_below(M, D, K, w, moves=None) -> np.ndarray:
     """Per set, the number of the exact operator's frequencies below w, proven, or -1 where
     the count cannot be proven in double precision.
 
@@ -287,7 +287,9 @@ def counts_below(M, D, K, w) -> np.ndarray:
     8 n eps ||SQS||_F of an eigenvalue of the matrix as formed, whose entries are within 64
     eps of their magnitude |K| + w^2 |M| + w |D| of the operator's (its forming and the
     evaluation of the operator); a count is proven where no eigenvalue is within the sum
-    of the two of zero (Weyl)."""
+    of the two of zero (Weyl). With `moves` (dM, dD, dK: the operator's own rounding,
+    gyro.qep.equilibrium_moves) the exact operator's matrix is within
+    |dK| + w^2 |dM| + w |dD| of the one formed, and its scaled Frobenius norm joins the sum."""
     n = M.shape[-1]
     w = np.asarray(w, dtype=float)[:, None, None]
     with np.errstate(all="ignore"):
@@ -300,6 +302,11 @@ def counts_below(M, D, K, w) -> np.ndarray:
         mu = np.linalg.eigvalsh(Q)
         margin = (8 * n * EPS * np.sqrt(np.sum(Q.real**2 + Q.imag**2, axis=(1, 2)))
                   + 64 * EPS * np.sqrt(np.sum(mag**2, axis=(1, 2))))
+        if moves is not None:
+            dM, dD, dK = moves
+            op = (dK + w**2 * dM + w * dD) * S
+            margin = margin + np.sqrt(np.sum(op**2, axis=(1, 2)))
+            good &= np.isfinite(margin)
         proven = good & (np.min(np.abs(mu), axis=1) > margin)
     return np.where(proven, np.sum(mu < 0, axis=1), -1)
 
@@ -307,15 +314,16 @@ def counts_below(M, D, K, w) -> np.ndarray:
 NOT_GYROSCOPIC = -2  # counts_at: M or K not symmetric, or D not skew, to the bit (no count)
 
 
-def counts_at(M, D, K, W, rows=None) -> np.ndarray:
+def counts_at(M, D, K, W, rows=None, moves=None) -> np.ndarray:
     """counts_below at the points W (sets, points) of each set: the compiled twin
     (gyro/questions/inertia.c: Bunch-Kaufman's LDL^H of the same scaled matrix, its inertia
     that of the blocks, proven by the factorization's backward error against the smallest
     block over ||L^-1||_F^2; in real arithmetic where a 2-colouring of the coordinates makes
     the matrix real) where a compiler is at hand, else LAPACK's eigenvalues in NumPy.
     `rows` (sets,): set k's operator is M[rows[k]] (no copies of a shared batch's); None:
-    M[k]. -> (sets, points), -1 where not proven, NOT_GYROSCOPIC for every point of a set
-    whose operator is not conservative gyroscopic (bearing damping)."""
+    M[k]. `moves` (dM, dD, dK, laid out as M): the operator's own rounding, which the proof
+    then carries (counts_below). -> (sets, points), -1 where not proven, NOT_GYROSCOPIC for
+    every point of a set whose operator is not conservative gyroscopic (bearing damping)."""
     from gyro import cbackend
     from gyro.qep import gyroscopic
 
@@ -325,20 +333,24 @@ def counts_at(M, D, K, W, rows=None) -> np.ndarray:
     except cbackend.CompilerUnavailable:
         if rows is not None:
             M, D, K = M[rows], D[rows], K[rows]
+            moves = None if moves is None else tuple(X[rows] for X in moves)
         c = np.empty(W.shape, int)
         for s in chunks(N, max(1, 8192 // max(Pn, 1))):  # bounded memory: a matrix per count
             rep = lambda X: np.repeat(X[s], Pn, axis=0)  # noqa: E731
-            c[s] = counts_below(rep(M), rep(D), rep(K), W[s].reshape(-1)).reshape(-1, Pn)
+            mv = None if moves is None else tuple(rep(X) for X in moves)
+            c[s] = counts_below(rep(M), rep(D), rep(K), W[s].reshape(-1), mv).reshape(-1, Pn)
         c[~gyroscopic(M, D, K)] = NOT_GYROSCOPIC
         return c
     import ctypes
 
     arrs = [np.ascontiguousarray(X, dtype=float) for X in (M, D, K)]
+    mv = None if moves is None else [np.ascontiguousarray(X, dtype=float) for X in moves]
     w = np.ascontiguousarray(W, dtype=float)
     index = None if rows is None else np.ascontiguousarray(rows, dtype=np.int64)
     out = np.empty(W.shape)
     ptr = ctypes.POINTER(ctypes.c_double)
     fn(ctypes.c_long(N), ctypes.c_long(M.shape[-1]), ctypes.c_long(Pn), *[a.ctypes.data_as(ptr) for a in arrs],
+       *([None] * 3 if mv is None else [a.ctypes.data_as(ptr) for a in mv]),
        None if index is None else index.ctypes.data_as(ctypes.POINTER(ctypes.c_long)),
        w.ctypes.data_as(ptr), out.ctypes.data_as(ptr))
     c = out.astype(int)
@@ -347,7 +359,7 @@ def counts_at(M, D, K, W, rows=None) -> np.ndarray:
     k, p = np.nonzero((c == -1) & np.isfinite(W) & (W >= 0))
     if k.size:
         r = k if rows is None else np.asarray(rows)[k]
-        c[k, p] = counts_below(M[r], D[r], K[r], W[k, p])
+        c[k, p] = counts_below(M[r], D[r], K[r], W[k, p], None if moves is None else tuple(X[r] for X in moves))
     return c
 
 
@@ -379,19 +391,22 @@ class Exact:
     def take(self, rows) -> "Exact":
         return Exact(self.model, self.P, self.rows[rows], self.store)
 
+    KEYS = ("M", "D", "K", "dM", "dD", "dK", "zero")
+
     def get(self):
         """(ok (sets,): an equilibrium found; M, D, K; at (ok sets,): the row of M, D, K of
-        each such set; zero (ok sets,): its count at 0) for this view's sets."""
+        each such set; zero (ok sets,): its count at 0; moves: (dM, dD, dK), the operator's
+        own rounding, laid out as M) for this view's sets."""
         st = self.store
         todo = np.unique(self.rows[st["where"][self.rows] == -1])
         if todo.size:
-            ok, M, D, K, zero = _exact(self.model, self.P[todo])
+            ok, *made = _exact(self.model, self.P[todo])
             if "M" not in st:  # the first: kept as made
                 base = 0
-                st.update(M=M, D=D, K=K, zero=zero)
+                st.update(zip(self.KEYS, made))
             else:  # sets a cheaper level did not try (beyond its edges): appended
                 base = st["M"].shape[0]
-                for key, v in (("M", M), ("D", D), ("K", K), ("zero", zero)):
+                for key, v in zip(self.KEYS, made):
                     st[key] = np.concatenate([st[key], v])
             st["where"][todo] = -2  # tried: no equilibrium
             st["where"][todo[ok]] = base + np.arange(int(ok.sum()))
@@ -400,23 +415,29 @@ class Exact:
         at = where[ok]
         if "M" not in st:  # no set asked yet
             n = len(self.model.meta["reduced"])
-            return ok, np.zeros((0, n, n)), np.zeros((0, n, n)), np.zeros((0, n, n)), at, at
-        return ok, st["M"], st["D"], st["K"], at, st["zero"][at]
+            empty = np.zeros((0, n, n))
+            return ok, empty, empty, empty, at, at, (empty, empty, empty)
+        return ok, st["M"], st["D"], st["K"], at, st["zero"][at], (st["dM"], st["dD"], st["dK"])
 
 
 def _exact(model, P):
-    """(ok, M, D, K of the sets with an equilibrium, their counts at 0) over the batch P."""
+    """(ok, M, D, K of the sets with an equilibrium, their operator's own rounding dM, dD, dK
+    (gyro.qep.equilibrium_moves), their counts at 0) over the batch P."""
+    from gyro import qep
     from gyro.equilibrium import equilibria, operators
 
     qe, ok = equilibria(model, P)
     n = len(model.meta["reduced"])
     if not ok.any():
-        return ok, np.zeros((0, n, n)), np.zeros((0, n, n)), np.zeros((0, n, n)), np.zeros(0, int)
+        empty = np.zeros((0, n, n))
+        return ok, empty, empty, empty, empty, empty, empty, np.zeros(0, int)
     every = bool(ok.all())  # no copies of the batch where every set has its equilibrium
-    M, D, K = operators(model, P if every else P[ok], qe if every else qe[ok])
+    Pk, qk = (P, qe) if every else (P[ok], qe[ok])
+    M, D, K = operators(model, Pk, qk)
     M, D, K = (np.ascontiguousarray(X, dtype=float) for X in (M, D, K))
-    zero = counts_at(M, D, K, np.zeros((M.shape[0], 1)))[:, 0]
-    return ok, M, D, K, zero
+    moves = qep.equilibrium_moves(model, Pk, qk, M, D, K)
+    zero = counts_at(M, D, K, np.zeros((M.shape[0], 1)), moves=moves)[:, 0]
+    return (ok, M, D, K, *moves, zero)
 
 
 def certificate_data(model, P) -> Exact:
@@ -436,7 +457,7 @@ def certify(model, level, P, ans: Answer, bound: np.ndarray, idx, data: Exact | 
     shared with the other levels they try), made here where not given."""
     N = P.shape[0]
     out = np.full(N, "", object)
-    ok, M, D, K, at, zero = (data if data is not None else Exact(model, P)).get()
+    ok, M, D, K, at, zero, moves = (data if data is not None else Exact(model, P)).get()
     out[~ok] = "certificate: no equilibrium to count the exact operator's frequencies at"
     live = np.flatnonzero(ok)
     if live.size == 0:
@@ -450,7 +471,7 @@ def certify(model, level, P, ans: Answer, bound: np.ndarray, idx, data: Exact | 
             informative = np.isfinite(b[:, j]) & (b[:, j] < 1) & np.isfinite(f[:, j]) & (f[:, j] > 0)
             W[:, 2 * i] = np.where(informative, f[:, j] / (1 + b[:, j]), -1.0)
             W[:, 2 * i + 1] = np.where(informative, f[:, j] / (1 - b[:, j]), -1.0)
-    c = counts_at(M, D, K, W, at)
+    c = counts_at(M, D, K, W, at, moves)  # the operator's own rounding carried by the proof
     c[W < 0] = -1
     reason = np.full(live.size, "", object)
     reason[zero == NOT_GYROSCOPIC] = "certificate: the operator is not conservative gyroscopic (damping): no count"

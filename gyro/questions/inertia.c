@@ -17,6 +17,10 @@
  * count_one, by ||L^-1||_F ||B^-1 L^-1||_F before the product is formed (separation_bound:
  * the product's n^3 only where that does not decide). Each bounds ||(L B L^H)^-1||_2 from
  * above, as the product's norm does, so each proves the signs by the same Weyl argument.
+ * With dM, dD, dK (entrywise changes of M, D, K: the operator's own rounding,
+ * gyro.qep.equilibrium_moves; NULL: none), the exact operator differs from the one given by
+ * at most E_op, |E_op| <= |dK| + w^2 |dM| + w |dD|, whose scaled Frobenius norm joins the
+ * perturbations.
  * M, D, K are (sets, n, n) row-major, set b's the row rows[b] (b where rows is NULL), w (N, P),
  * out (N, P); n <= 32. Complex numbers are pairs
  * of doubles (C99's complex product calls a library routine for its infinities). */
@@ -48,13 +52,14 @@ static double separation_bound(long n, double xF, double zF)
     return sqrt(xF) * sqrt(zF) * (1.0 + 4.0 * (double)(n * n + n) * eps);
 }
 
-static double count_one(long n, const double *M, const double *D, const double *K, double w)
+static double count_one(long n, const double *M, const double *D, const double *K, const double *dM,
+                        const double *dD, const double *dK, double w)
 {
     double ar[NMAX][NMAX], ai[NMAX][NMAX], lr[NMAX][NMAX], li[NMAX][NMAX];
     double s[NMAX], binv[NMAX][4];  /* per pivot column: its block's inverse row, (re, im) x 2 */
     long bsize[NMAX];
     const double eps = 2.220446049250313e-16;
-    double magF = 0.0, normA = 0.0;
+    double magF = 0.0, normA = 0.0, opF = 0.0;
     for (long i = 0; i < n; i++) {
         double d = fabs(K[i * n + i]) + w * w * M[i * n + i];
         if (!(d > 0.0) || !isfinite(d)) return -1.0;
@@ -65,6 +70,11 @@ static double count_one(long n, const double *M, const double *D, const double *
             double sc = s[i] * s[j];
             double re = (K[i * n + j] - w * w * M[i * n + j]) * sc, im = w * D[i * n + j] * sc;
             double mg = (fabs(K[i * n + j]) + w * w * fabs(M[i * n + j]) + w * fabs(D[i * n + j])) * sc;
+            if (dM) {  /* the operator's own rounding, entrywise (gyro.qep.equilibrium_moves) */
+                double op = (dK[i * n + j] + w * w * dM[i * n + j] + w * dD[i * n + j]) * sc;
+                if (!isfinite(op)) return -1.0;
+                opF += op * op;
+            }
             if (!isfinite(re) || !isfinite(im) || !isfinite(mg)) return -1.0;
             ar[i][j] = re;
             ai[i][j] = im;
@@ -198,7 +208,7 @@ static double count_one(long n, const double *M, const double *D, const double *
             }
         i = o + 1;
     }
-    double pert = 8.0 * n * eps * (normA + growth) + 64.0 * eps * magF;
+    double pert = 8.0 * n * eps * (normA + growth) + 64.0 * eps * magF + sqrt(opF);
     if (2.0 * pert < 1.0 / separation_bound(n, xF, zF)) return (double)negative;
     double yF = 0.0;
     for (long i = 0; i < n; i++)
@@ -248,12 +258,13 @@ static int groups(long n, const double *M, const double *D, const double *K, int
 /* The count of count_one for the real symmetric form of groups(): the same scaling, pivoting,
  * backward error and separation, in real arithmetic (the factors are those of the complex
  * code applied to T^H A T, without the zero imaginary parts). */
-static double count_real(long n, const double *M, const double *Ds, const double *K, const double *D, double w)
+static double count_real(long n, const double *M, const double *Ds, const double *K, const double *D,
+                         const double *dM, const double *dD, const double *dK, double w)
 {
     double a[NMAX][NMAX], s[NMAX], binv[NMAX][2];  /* a: the active matrix, L stored below it */
     long bsize[NMAX];
     const double eps = 2.220446049250313e-16, w2 = w * w;
-    double magF = 0.0, normA = 0.0;
+    double magF = 0.0, normA = 0.0, opF = 0.0;
     for (long i = 0; i < n; i++) {
         double d = fabs(K[i * n + i]) + w2 * M[i * n + i];
         if (!(d > 0.0) || !isfinite(d)) return -1.0;
@@ -271,7 +282,12 @@ static double count_real(long n, const double *M, const double *Ds, const double
             a[i][j] = v;
             sm[j] += mg * mg;
             sa[j] += v * v;
+            if (dM) {  /* the operator's own rounding, entrywise (gyro.qep.equilibrium_moves) */
+                double op = (dK[i * n + j] + w2 * dM[i * n + j] + w * dD[i * n + j]) * sc;
+                opF += op * op;
+            }
         }
+    if (!isfinite(opF)) return -1.0;
     for (long j = 0; j < n; j++) { magF += sm[j]; normA += sa[j]; }
     if (!isfinite(magF) || !isfinite(normA)) return -1.0;  /* the sums of squares, rooted in pert */
     double growth = 0.0;
@@ -331,7 +347,7 @@ static double count_real(long n, const double *M, const double *Ds, const double
         }
         k += size;
     }
-    double pert = 8.0 * n * eps * (sqrt(normA) + growth) + 64.0 * eps * sqrt(magF);
+    double pert = 8.0 * n * eps * (sqrt(normA) + growth) + 64.0 * eps * sqrt(magF) + sqrt(opF);
     /* first in O(n^2): |L^-1| <= C^-1 entrywise for the comparison matrix C of L (unit
      * diagonal, -|l_ij| below it), so ||L^-1||_inf <= max(C^-1 e) and ||L^-1||_1 <=
      * max(C^-T e), both sums of positive terms (their rounding within 2 n^2 eps, covered by
@@ -418,11 +434,14 @@ static int gyroscopic(long n, const double *M, const double *D, const double *K)
 }
 
 void gyro_inertia_counts(long N, long n, long P, const double *M, const double *D, const double *K,
+                         const double *dM, const double *dD, const double *dK,
                          const long *rows, const double *w, double *out)
 {
     for (long b = 0; b < N; b++) {
         long r = rows ? rows[b] : b;  /* the set's operator: its row of M, D, K */
         const double *Mb = M + r * n * n, *Db = D + r * n * n, *Kb = K + r * n * n;
+        const double *dMb = dM ? dM + r * n * n : NULL, *dDb = dM ? dD + r * n * n : NULL,
+                     *dKb = dM ? dK + r * n * n : NULL;
         int structured = gyroscopic(n, Mb, Db, Kb), g[NMAX];
         int real = structured && n <= NMAX && groups(n, Mb, Db, Kb, g);
         double Ds[NMAX * NMAX];  /* D with the signs of the real form: -D in rows of group 0 */
@@ -431,6 +450,7 @@ void gyro_inertia_counts(long N, long n, long P, const double *M, const double *
                 for (long j = 0; j < n; j++) Ds[i * n + j] = (g[i] == 0) ? -Db[i * n + j] : Db[i * n + j];
         for (long p = 0; p < P; p++)
             out[b * P + p] = !structured ? -2.0 : (n > NMAX) ? -1.0
-                             : real ? count_real(n, Mb, Ds, Kb, Db, w[b * P + p]) : count_one(n, Mb, Db, Kb, w[b * P + p]);
+                             : real ? count_real(n, Mb, Ds, Kb, Db, dMb, dDb, dKb, w[b * P + p])
+                                    : count_one(n, Mb, Db, Kb, dMb, dDb, dKb, w[b * P + p]);
     }
 }

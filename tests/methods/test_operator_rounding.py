@@ -79,3 +79,41 @@ def test_the_compiled_contraction_is_the_numpy_one(ghc):
         c_side = qep.hermitian_moves(moves, M, D, w, z, m)
         assert np.all(np.isfinite(numpy_side))
         assert np.allclose(c_side, numpy_side, rtol=1e-13, atol=0), np.max(np.abs(c_side / numpy_side - 1))
+
+
+def test_the_certificates_count_carries_the_operators_rounding():
+    """The count that proves a cheap level's answer (gyro/questions/inertia.c and its NumPy
+    twin) takes the operator's own rounding as a perturbation of Q(w): near a frequency,
+    where the count's separation from zero is small, a rounding large enough to move a
+    frequency across the point leaves the count unproven (-1) instead of a count of the
+    double operator's frequencies; with the rounding as probed, the counts are those
+    without it away from the frequencies, in C and in NumPy alike."""
+    from gyro import cbackend, qep
+    from gyro.equilibrium import equilibria, operators
+    from gyro.questions.frequencies import counts_at
+
+    tg = load("torsion_gyrocompass")
+    P = np.tile(tg.vector(), (20, 1)) * np.exp(np.random.default_rng(4).uniform(-0.3, 0.3, (20, len(tg.param_names))))
+    qe, _ = equilibria(tg, P)
+    M, D, K = operators(tg, P, qe)
+    moves = qep.equilibrium_moves(tg, P, qe, M, D, K)
+    w = ladder.spectrum(tg, P, "default").frequencies
+    far = np.concatenate([w * (1 - 1e-6), w * (1 + 1e-6)], axis=1)
+    near = np.concatenate([w * (1 - 1e-9), w * (1 + 1e-9)], axis=1)
+    big = tuple(1e6 * X for X in moves)  # a million times the probed rounding: ~1e-9 relative
+    for disabled in (False, True):
+        with cbackend.disabled() if disabled else _nothing():
+            plain, probed = counts_at(M, D, K, far), counts_at(M, D, K, far, moves=moves)
+            assert np.all(plain >= 0) and np.array_equal(plain, probed)  # the rounding moves no count
+            # 1e-9 from every frequency: proven with the rounding as probed, not with a
+            # rounding that could move a frequency across the point
+            assert np.all(counts_at(M, D, K, near, moves=moves) >= 0)
+            assert np.all(counts_at(M, D, K, near, moves=big) == -1)
+
+
+class _nothing:
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False

@@ -25,6 +25,7 @@
  * out (N, P); n <= 32. Complex numbers are pairs
  * of doubles (C99's complex product calls a library routine for its infinities). */
 #include <math.h>
+#include <stddef.h>
 #include "inertia.h"
 
 #define NMAX 32

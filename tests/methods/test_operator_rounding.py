@@ -90,8 +90,9 @@ def test_the_certificates_count_carries_the_operators_rounding():
     without it away from the frequencies, in C and in NumPy alike."""
     from gyro import cbackend, qep
     from gyro.equilibrium import equilibria, operators
-    from gyro.questions.frequencies import counts_at
+    from gyro.questions.frequencies import _inertia_kernel, counts_at
 
+    _inertia_kernel()  # compiled here: C and NumPy below are two counts, not one twice
     tg = load("torsion_gyrocompass")
     P = np.tile(tg.vector(), (20, 1)) * np.exp(np.random.default_rng(4).uniform(-0.3, 0.3, (20, len(tg.param_names))))
     qe, _ = equilibria(tg, P)

@@ -251,8 +251,10 @@ def _say(out: np.ndarray, flags: np.ndarray, text) -> None:
 # count (the compiled inertia, counts_at) and the rest of a certificate beside its counts (the
 # equilibrium, the operator, the count at 0, the bookkeeping), measured in one run of
 # `python -m bench.levels --random-speed 100000` (levels.json random_speed.certificate.declare)
-COUNT_COST = 1.7e-6
-OPERATOR_COST = 8.1e-6
+# (the rest now includes the operator's own rounding, two probes of the operator: 2.5 ->
+# 4.9 us a set of the run)
+COUNT_COST = 1.34e-6
+OPERATOR_COST = 1.25e-5
 # The most requested modes for which the certified levels, tried before the exact operator,
 # answered faster than it alone in that run (random_speed.modes_1e-3: modes 1..k at 1e-3, each
 # set trying the levels in turn, a certificate for each; each mode alone was faster too).

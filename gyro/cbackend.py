@@ -199,6 +199,11 @@ def _build(cc: str, sources, out: Path, key: str, defines=(), notice: str = "") 
                                "-o", str(tmp_so), "-lm"], capture_output=True, text=True)
         if proc.returncode != 0:  # remembered: one failed build per process, not one per call
             _FAILED[key] = CompilerUnavailable(f"{cc} failed on {what}: {proc.stderr.strip()[:500]}")
+            # said once, on the line after the notice: the NumPy paths answer, slower, and a
+            # broken source is not mistaken for a machine without a compiler
+            first = next((ln for ln in proc.stderr.splitlines() if "error" in ln), proc.stderr.strip()[:200])
+            print(f"gyro: compiling {notice} failed ({first.strip()}); the NumPy paths answer instead",
+                  file=sys.stderr, flush=True)
             raise _FAILED[key]
         seal = Path(tmp) / "seal"
         seal.write_text(_digest(tmp_so) + "\n")

@@ -166,3 +166,19 @@ def test_the_generated_c_holds_no_kernel_and_the_input_hash_none_of_their_source
     entry = re.compile(r"\w+_(qep_refine|qep_block_starts|qep_hermitian|sens_null_vectors|sens_contract|poly_roots)_batch\b")
     for name in available():
         assert not entry.search((GENERATED / name / f"{name}.c").read_text()), name
+
+
+def test_a_source_that_does_not_compile_says_so_once(tmp_path, monkeypatch, capsys):
+    """A build that fails (a broken source, not a missing compiler) says so on stderr, once
+    per process, and the caller's NumPy path answers: found when a NULL without its header
+    made the certificate's count fall back to NumPy unseen."""
+    from gyro import cbackend
+
+    monkeypatch.setattr(cbackend, "cache_dir", lambda: tmp_path)
+    src = tmp_path / "broken.c"
+    src.write_text("double f(void) { return undeclared_name; }\n")
+    for _ in range(2):
+        with pytest.raises(cbackend.CompilerUnavailable):
+            cbackend._shared("broken", (src,), (), notice="the generated C of a broken test source")
+    err = capsys.readouterr().err
+    assert err.count("failed (") == 1 and "undeclared_name" in err and "NumPy paths answer" in err

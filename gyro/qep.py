@@ -318,12 +318,14 @@ def rayleigh(model: Model, M, D, K, w, z, iters, tol, chunk=256, overwrite=False
     return w, z, est, ok
 
 
-def general(M, D, K):
+def general(M, D, K, moves=None):
     """The general rung for one set: companion eigenvalues, each refined by Newton on J.
 
     The estimate is the last Newton step (quadratic convergence leaves far less) plus the
     rounding floor eps |y| (|M||l|^2 + |D||l| + |K|) |x| / (|l| |y* J'(l) x|) of the root,
-    with x, y the singular vectors of J(l) at its smallest singular value."""
+    with x, y the singular vectors of J(l) at its smallest singular value; with `moves`
+    (|dM|, |dD|, |dK|: the operator's own rounding, equilibrium_moves) also the same form
+    in them (as general_moves, from the same vectors)."""
     n = M.shape[0]
     if not (tame(M) and tame(D) and tame(K)):
         return np.full(n, np.nan + 0j), np.full(n, np.inf)
@@ -336,16 +338,15 @@ def general(M, D, K):
         scale = np.abs(y) @ (np.abs(M) * abs(lam)**2 + np.abs(D) * abs(lam) + np.abs(K)) @ np.abs(x)
         slope = abs(y.conj() @ (2 * M * lam + D) @ x) * max(abs(lam), 1e-300)
         est[j] = errs[j] + 4 * n * EPS * scale / max(slope, 1e-300)
+        if moves is not None:
+            dM, dD, dK = moves
+            op = np.abs(y) @ (dM * abs(lam)**2 + dD * abs(lam) + dK) @ np.abs(x)
+            est[j] += 0.0 if op == 0 else op / slope if slope > 0 else np.inf
     return roots, est
 
 
 EQ_MOVE = 2 * EPS  # each equilibrium coordinate moved by this, relative: 4x its rounding's u |q|
 INPUT_MOVE = 4 * EPS  # each parameter moved by this, relative (as input_rounding moves them)
-
-
-def _pattern(m: int, period: int) -> np.ndarray:
-    """Signs +1/-1 over m entries, alternating in runs of `period`."""
-    return np.where((np.arange(m) // period) % 2 == 0, 1.0, -1.0)
 
 
 def equilibrium_moves(model: Model, P, qe, M, D, K):
@@ -366,8 +367,7 @@ def equilibrium_moves(model: Model, P, qe, M, D, K):
     out = None
     with np.errstate(all="ignore"):  # a non-finite change stays one: no bound there
         for period in (1, 2):
-            Pm = P * (1 + INPUT_MOVE * _pattern(P.shape[-1], period))
-            qm = qe * (1 + EQ_MOVE * _pattern(qe.shape[-1], period))
+            Pm, qm = moved(P, INPUT_MOVE, period), moved(qe, EQ_MOVE, period)
             d = operators(model, Pm, qm)  # fresh arrays of our own: changed in place
             for X, Y in zip(d, (M, D, K)):
                 np.abs(np.subtract(X, Y, out=X), out=X)
@@ -425,12 +425,12 @@ def general_moves(moves, M, D, K, lam, chunk=1024) -> np.ndarray:
     return out
 
 
-def moved(p, rel):
-    """Parameters (last axis; NumPy or a list of mpf) each moved by rel relative, with
-    alternating signs: a fixed, reproducible perturbation of the inputs."""
+def moved(p, rel, period: int = 1):
+    """Parameters (last axis; NumPy or a list of mpf) each moved by rel relative, with signs
+    alternating in runs of `period`: a fixed, reproducible perturbation of the inputs."""
     if isinstance(p, np.ndarray):
-        return p * (1 + rel * np.where(np.arange(p.shape[-1]) % 2 == 0, 1.0, -1.0))
-    return [v * (1 + (rel if i % 2 == 0 else -rel)) for i, v in enumerate(p)]
+        return p * (1 + rel * np.where((np.arange(p.shape[-1]) // period) % 2 == 0, 1.0, -1.0))
+    return [v * (1 + (rel if (i // period) % 2 == 0 else -rel)) for i, v in enumerate(p)]
 
 
 def general_at(model: Model, p: np.ndarray) -> np.ndarray:

@@ -34,6 +34,14 @@ class Parser(argparse.ArgumentParser):
 
 
 
+def has_levels(meta: dict) -> bool:
+    """Declared levels, or the implicit exact one (gyro.levels.declarations): what
+    `scene` and `level-map` need."""
+    from gyro.levels import declarations
+
+    return bool(declarations(meta))
+
+
 def has_spin(meta: dict) -> bool:
     """An operator and a spin: a declared one (Model.spin) or a parameter in rad/s."""
     return has_operator(meta) and bool(meta.get("spin") or any(p["unit"] == "rad/s" for p in meta["parameters"]))

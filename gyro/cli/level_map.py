@@ -12,24 +12,17 @@ from __future__ import annotations
 import json
 import sys
 
-from gyro.cli.common import (add_json, add_model, add_out, add_quiet, add_set, check_png_out, parse_sets,
+from gyro.cli.common import (add_json, add_model, add_out, add_quiet, add_set, check_png_out, has_levels, parse_sets,
                              refuse_over_budget)
 from gyro.errors import ParameterError, finite_number
 
 ORDER = 36
 
 
-def _has_levels(meta: dict) -> bool:
-    """Declared levels, or the implicit exact one (gyro.levels.declarations)."""
-    from gyro.levels import declarations
-
-    return bool(declarations(meta))
-
-
 def register(sub) -> None:
     s = sub.add_parser("level-map", help="the error of one level of a model's hierarchy against another "
                        "over two parameters")
-    add_model(s, help="the model: a hierarchy of levels (Model.levels)", declares=_has_levels)
+    add_model(s, help="the model: a hierarchy of levels (Model.levels)", declares=has_levels)
     s.add_argument("--level", required=True, metavar="LEVEL", help="the level whose error is mapped")
     s.add_argument("--against", required=True, metavar="LEVEL", help="the more exact level")
     s.add_argument("--x", required=True, metavar="NAME=LO:HI:N", help="x axis: a parameter")

@@ -8,24 +8,17 @@ from __future__ import annotations
 import json
 import sys
 
-from gyro.cli.common import add_json, add_model, add_set, parse_sets
+from gyro.cli.common import add_json, add_model, add_set, has_levels, parse_sets
 from gyro.errors import ParameterError, finite_number
 
 ORDER = 15
-
-
-def _has_levels(meta: dict) -> bool:
-    """Declared levels, or the implicit exact one (gyro.levels.declarations)."""
-    from gyro.levels import declarations
-
-    return bool(declarations(meta))
 
 
 def register(sub) -> None:
     from gyro.questions import names
 
     f = sub.add_parser("scene", help="answer a question at a tolerance with the cheapest adequate level")
-    add_model(f, help="the model: a hierarchy of levels (Model.levels)", declares=_has_levels)
+    add_model(f, help="the model: a hierarchy of levels (Model.levels)", declares=has_levels)
     f.add_argument("question", metavar="QUESTION", choices=names(),
                    help=f"what to answer; one of: {', '.join(names())}")
     f.add_argument("--tol", required=True, metavar="REL", help="relative tolerance, a number in (0, 1)")

@@ -72,10 +72,8 @@ def solve(model: Model, P: np.ndarray, tol: float = DEFAULT_TOL) -> Spectrum:
     zero_root = np.zeros((N, n), bool)
     for k in np.flatnonzero(good & ~herm):
         route[k] = "general"
-        roots, e = qep.general(M[k], D[k], K[k])
+        roots, e = qep.general(M[k], D[k], K[k], tuple(X[k] for X in moves))  # with the operator's rounding
         e = e + qep.input_rounding(model, P[k], roots, lambda Pp: qep.general_at(model, Pp))
-        e = e + qep.general_moves(tuple(X[k:k + 1] for X in moves), M[k:k + 1], D[k:k + 1], K[k:k + 1],
-                                  roots[None])[0]
         freq[k], growth[k], est[k] = np.abs(roots.imag), roots.real, e
         # an exact zero root (omega1 without Earth rate, u = 0: a free azimuth). lambda = 0 is
         # a root exactly when K is singular; where K is singular in double precision to the

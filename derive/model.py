@@ -180,9 +180,12 @@ class Level:
 def runtime_module(model, name: str) -> str:
     """How the runtime finds a module a model declares (a simulate hook, a level's evaluator):
     a dotted name it can import where the module lies outside the model's own folder (the
-    package's gyro.systems.<system>), else "file:" and the module's path: the model file
-    itself (`__name__`) or a Python file beside it, which the runtime cannot import by the
-    name the derivation used."""
+    package's gyro.systems.<system>), else "file:" and the module's path relative to the
+    model file's folder: the model file itself (`__name__`) or a Python file beside it,
+    which the runtime cannot import by the name the derivation used, and finds beside the
+    file it loads the model from (gyro.catalog.declared_module). Relative, so that no byte
+    depends on where a checkout lives: one derivation in the cache serves every checkout
+    with the same files (an absolute path named the first checkout, and broke when it went)."""
     import importlib.util
     import sys
     from pathlib import Path
@@ -202,7 +205,9 @@ def runtime_module(model, name: str) -> str:
     origin = Path(origin).resolve()
     if name == model.module or (folder is not None and folder in origin.parents and
                                 not (Path(__file__).resolve().parents[1] / "gyro") in origin.parents):
-        return f"file:{origin}"
+        if folder is not None and folder in origin.parents:
+            return f"file:{origin.relative_to(folder).as_posix()}"
+        return f"file:{origin}"  # a module without a folder of its own: only where it is
     return name
 
 

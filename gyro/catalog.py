@@ -40,10 +40,11 @@ def declaring(predicate) -> list[str]:
     return [n for n in available() if predicate(metadata(n))]
 
 
-def declared_module(spec: str, what: str):
+def declared_module(spec: str, what: str, model=None):
     """The module a model declares for the runtime (derive.model.runtime_module): a dotted
     name imported as such, or "file:PATH", a model file or a file beside it, loaded from its
-    path once. ParameterError in one line (naming `what`) where it cannot be loaded."""
+    path once; a relative PATH from the folder `model` was loaded from (its
+    `source_folder`). ParameterError in one line (naming `what`) where it cannot be loaded."""
     import importlib
     import importlib.util
     import sys
@@ -52,6 +53,12 @@ def declared_module(spec: str, what: str):
         if not spec.startswith("file:"):
             return importlib.import_module(spec)
         path = Path(spec[5:])
+        if not path.is_absolute():
+            base = getattr(model, "source_folder", None)
+            if base is None:
+                raise ImportError("it lies beside the model file, which is not known here: "
+                                  "load the model by its file PATH.py")
+            path = base / path
         key = f"_gyro_declared_{abs(hash(str(path))):x}"
         if key not in sys.modules:
             found = importlib.util.spec_from_file_location(key, path)

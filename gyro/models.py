@@ -73,6 +73,10 @@ class Model:
             raise ParameterError(f"{self.directory / 'metadata.json'}: not a generated model's metadata "
                                  f"(its parameters: {_reason(exc)})") from None
         self.param_names = [p.name for p in self.params]
+        # the folder of the model file it was loaded from (load() sets it for a model file;
+        # else the checkout's, where the metadata names a source inside it): where a
+        # declared "file:" module is found (gyro.catalog.declared_module)
+        self.source_folder = _declared_source_folder(self.meta)
 
     @cached_property
     def numpy(self):
@@ -162,6 +166,16 @@ def has_operator(meta: dict) -> bool:
     return "operator" in meta.get("functions", {}) and not meta.get("momenta")
 
 
+def _declared_source_folder(meta: dict) -> Path | None:
+    """The folder of the model's source file as its metadata names it (relative to the
+    source checkout), where this runtime runs from that checkout and the file is there."""
+    source = (meta.get("generated") or {}).get("source")
+    root = _source_root()
+    if not isinstance(source, str) or root is None or not (root / source).is_file():
+        return None
+    return (root / source).parent
+
+
 def _import_directory(directory: Path) -> str:
     """Import a generated package from a folder anywhere, under a private name."""
     import hashlib
@@ -237,6 +251,9 @@ def load(name: str | Path) -> Model:
         # a model file whose derivation is a generated package (derived_folder): that model
         builtin = kind == "file" and directory == GENERATED / model_name
         _CACHE[model_name] = Model(model_name) if builtin else Model(model_name, directory)
+    if kind == "file":  # this file's folder, wherever a derivation in the cache was made from
+        source = Path(text).expanduser().resolve()
+        _CACHE[model_name].source_folder = source if source.is_dir() else source.parent
     return _CACHE[model_name]
 
 

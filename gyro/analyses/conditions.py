@@ -105,7 +105,7 @@ def system(model: Model):
     name = model.meta.get("system")
     if not name:
         return None
-    return declared_module(name, f"{model.name}: its declared system")
+    return declared_module(name, f"{model.name}: its declared system", model)
 
 
 def _hook(model: Model, name: str, default=None):

@@ -26,7 +26,7 @@ def run(args) -> int:
         from gyro.catalog import declared_module
 
         print(f"initial conditions (gyro simulate; {own['initial']}):")
-        for name, (unit, default, description) in declared_module(own["module"], f"{model.name}'s motion").INITIAL.items():
+        for name, (unit, default, description) in declared_module(own["module"], f"{model.name}'s motion", model).INITIAL.items():
             print(f"{name:<8} {default:>14.8g} {unit:<10} {description}")
     if own and own.get("usage"):
         print(f"gyro simulate {model.name}: {own['usage']}")

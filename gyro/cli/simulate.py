@@ -128,7 +128,7 @@ def run(args) -> int:
                                  "model's own, Model.simulate)"))
     if decl:
         cli = SimpleNamespace(sets=parse_sets, times=_times, perturb_items=_perturb_items, png=_png, method=_method)
-        result = declared_module(decl["module"], f"{model.name}'s motion").simulate_command(model, args, cli)
+        result = declared_module(decl["module"], f"{model.name}'s motion", model).simulate_command(model, args, cli)
         out = Path(args.out) if args.out is not None else None
     else:
         result, out = _run_generic(model, args)

@@ -85,7 +85,7 @@ def get(name: str):
     return importlib.import_module(f"{__name__}.{_declared()[name]}")
 
 
-def evaluator_module(level):
+def evaluator_module(level, model=None):
     """The module a level's evaluator declares ("module": a dotted name; gyro.systems.<system>
     for the papers' models, any importable module for a user's); ParameterError in one line
     where it is missing or cannot be imported."""
@@ -97,7 +97,7 @@ def evaluator_module(level):
                              "module (\"module\": a dotted name)")
     from gyro.catalog import declared_module
 
-    return declared_module(name, f"level {level.name}")
+    return declared_module(name, f"level {level.name}", model)
 
 
 def unknown_kind(question: str, level) -> ValueError:

@@ -67,7 +67,7 @@ def answer(model, level, P, opts) -> Answer:
     kind = level.evaluator.get("kind")
     if kind not in ("harmonic", "harmonic_balance"):
         raise unknown_kind(NAME, level)
-    forced = evaluator_module(level)  # its harmonic_balance (the torsion gyrocompass's own)
+    forced = evaluator_module(level, model)  # its harmonic_balance (the torsion gyrocompass's own)
     s, k, a, phi = harmonic(opts)
     N, n = P.shape[0], len(quantities(model, opts))
     X = np.full((N, n), np.nan, complex)

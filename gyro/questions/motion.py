@@ -77,7 +77,7 @@ def _fastest(model, P, initial: dict, extra: dict) -> float:
 def _analysis(level, model):
     """The level's evaluator: its module, or what the module gives for this model where it
     serves any model (gyro.analyses.motion.for_model)."""
-    mod = evaluator_module(level)
+    mod = evaluator_module(level, model)
     return mod.for_model(model) if hasattr(mod, "for_model") else mod
 
 

@@ -192,3 +192,36 @@ def test_the_generic_motion_refuses_a_model_with_multipliers(tmp_path):
     (line,) = error_lines(err)
     assert "no level gives a finite bound here (linear: hoop_levels: its constraints are carried by multipliers" \
         in line
+
+
+def test_a_declared_file_module_is_found_beside_the_file_loaded_not_where_it_was_derived(tmp_path):
+    """The derivation records a model file's own module relative to its folder
+    (derive.model.runtime_module), and the runtime finds it beside the file it loads the
+    model from. Before, the path was absolute: a derivation in the cache (keyed by the
+    files' bytes and their paths inside the checkout) made in one checkout named that
+    checkout, and failed from a fresh clone once the first was gone ("no file
+    /work/.../oscillator_own_motion.py"): the cached metadata here is moved as such."""
+    import shutil
+    from pathlib import Path
+
+    from gyro import models
+    from gyro.catalog import declared_module
+    from gyro.errors import ParameterError
+
+    m = models.load(OWN)
+    spec = m.meta["simulate"]["module"]
+    assert spec == "file:oscillator_own_motion.py"
+    assert m.source_folder == MODELS.resolve()
+    # the same emitted folder loaded as a folder: the checkout's file its metadata names
+    copy = tmp_path / m.name
+    shutil.copytree(m.directory, copy, ignore=shutil.ignore_patterns("__pycache__", "*.so"))
+    elsewhere = models.Model(m.name, copy)
+    assert elsewhere.source_folder == MODELS.resolve()
+    # and where no model file is known (an installed runtime): refused in one line
+    elsewhere.source_folder = None
+    with pytest.raises(ParameterError, match="load the model by its file PATH.py"):
+        declared_module(spec, "its motion", elsewhere)
+    # and beside another copy of the file, that copy's module
+    (tmp_path / "oscillator_own_motion.py").write_text((MODELS / "oscillator_own_motion.py").read_text())
+    elsewhere.source_folder = tmp_path
+    assert Path(declared_module(spec, "its motion", elsewhere).__file__).parent == tmp_path

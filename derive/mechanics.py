@@ -16,11 +16,44 @@ and derivatives fast. Every step is a plain function that can be called on its o
 """
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 from typing import Sequence
 
-import symengine as se
 import sympy as sp
+
+
+class _WithoutNumpy:
+    """A finder that answers an import of NumPy with ModuleNotFoundError, as if absent."""
+
+    @staticmethod
+    def find_spec(name, path=None, target=None):
+        if name == "numpy" or name.startswith("numpy."):
+            raise ModuleNotFoundError("NumPy withheld from symengine's import", name=name)
+        return None
+
+
+def _import_symengine():
+    """symengine, imported without NumPy where NumPy is not loaded yet. symengine's wrapper
+    imports NumPy only for Lambdify and for converting NumPy scalars and arrays (it checks
+    for NumPy and does without), none of which the derivation asks of it; NumPy's import is
+    0.06-0.1 s of CPU, as much as the whole derivation of a small model
+    (bench/sympy_systems.py: disc_incline's derivation 0.022 s). A process that has NumPy
+    already (the runtime deriving a model file) keeps symengine's NumPy support."""
+    if "numpy" in sys.modules:
+        import symengine
+
+        return symengine
+    finder = _WithoutNumpy()
+    sys.meta_path.insert(0, finder)
+    try:
+        import symengine
+    finally:
+        sys.meta_path.remove(finder)
+    return symengine
+
+
+se = _import_symengine()
 
 # --------------------------------------------------------------------------- rotations
 

@@ -108,15 +108,36 @@ def parameters(sets: dict | None = None, orbit: bool = False, base: dict | None 
 
 
 def check_equilibrium(values: dict) -> None:
-    """ParameterError unless the relative equilibrium (3.1)-(3.2) exists at these values."""
+    """ParameterError unless the relative equilibrium (3.1)-(3.2) exists at these values.
+    Where it does not, the equations may still have an equilibrium of their own, off the
+    family (3.1) (beta != 0: at zeta = 0.1 on the Earth set beta = 6.3e-4 rad, epsilon = 0;
+    at eta = 0.2, lambda = 1.2 beta = -3.0e-5 rad; each a root of the emitted residual to
+    1e-60 at 60 digits): the message names it, so that no one reads "no equilibrium" where
+    there is one."""
     ratio = values["I"] * values["lam"] * values["zeta"] / (2 * values["L"])
     if not ratio < 1:
-        raise ParameterError(f"no equilibrium: I lambda zeta/2L = {ratio:.6g} >= 1 (3.1) "
-                             "(lower zeta, I or lambda, or raise L)")
+        raise ParameterError(f"no relative equilibrium (3.1): I lambda zeta/2L = {ratio:.6g} >= 1 (lower zeta, I "
+                             f"or lambda, or raise L){_other_equilibrium(values)}")
     one_chi = 1.0 + (values["C"] - values["B"]) / values["I"]
     if values["eta"] != 0 and abs(values["lam"] - one_chi) > LAMBDA_TOL * max(1.0, abs(one_chi)):
-        raise ParameterError(f"no equilibrium: eta = {values['eta']!r} != 0 needs lambda = 1 + chi = "
-                             f"{one_chi!r} (3.2), got lambda = {values['lam']!r}")
+        raise ParameterError(f"no relative equilibrium (3.1): eta = {values['eta']!r} != 0 needs lambda = 1 + chi = "
+                             f"{one_chi!r} (3.2), got lambda = {values['lam']!r}{_other_equilibrium(values)}")
+
+
+def _other_equilibrium(values: dict) -> str:
+    """'; the equations' own equilibrium here: ...' where the generic Newton (gyro.equilibrium,
+    its residual test) finds one at these values, '; nor any other equilibrium from the
+    Newton's starts' where it does not."""
+    from gyro.equilibrium import equilibria
+
+    m = model()
+    with np.errstate(all="ignore"):
+        qe, ok = equilibria(m, m.vector(values)[None, :])
+    if not ok[0]:
+        return "; nor does the generic Newton find another equilibrium from its starts"
+    at = ", ".join(f"{c} = {x:.6g}" for c, x in zip(m.meta["equilibrium_coordinates"], qe[0]))
+    return (f"; the equations have another equilibrium here, {at} rad, off (3.1): "
+            f"`gyro frequencies {m.name}` analyses it")
 
 
 def with_axis(values: dict, name: str, value: float) -> dict:

@@ -277,7 +277,7 @@ def test_map_theta_chi_text(tmp_path):
 
 
 MAP_BAD = [
-    (["--x", "zeta=0:1.2:11", "--y", "eta=0:1:11"], "no equilibrium"),  # zeta = 1.2: I lambda zeta/2L > 1
+    (["--x", "zeta=0:1.2:11", "--y", "eta=0:1:11"], "no relative equilibrium (3.1)"),  # zeta = 1.2: I lambda zeta/2L > 1
     (["--x", "foo=0:1:3", "--y", "eta=0:1:3"], "foo"),
     (["--x", "zeta=0:1", "--y", "eta=0:1:3"], "NAME=LO:HI:N"),
     (["--x", "zeta=1:0:3", "--y", "eta=0:1:3"], "LO < HI"),
@@ -417,3 +417,18 @@ def test_the_printed_3_6_rows_are_left_out_where_lambda_is_not_1_plus_chi():
     d = json.loads(out)  # lambda = 1 + chi: (3.6) and (4.3) both reported, and agree ((4.2))
     c = d["conditions"]
     assert all(c[k] > 0 for k in c if k.startswith("(3.6)")) == all(c[k] > 0 for k in c if k.startswith("(4.3)"))
+
+
+@pytest.mark.parametrize("args", [["--set=eta=0.2", "--set=lambda=1.2"], ["--set=zeta=0.1"]],
+                         ids=["lambda off 1 + chi", "I lambda zeta/2L >= 1"])
+def test_without_3_1_the_refusal_names_the_equations_own_equilibrium(args):
+    """Where (3.1)-(3.2) does not exist the equations still have an equilibrium (beta != 0;
+    a root of the residual to 1e-60 at 60 digits): the refusal says so and names it, and it
+    is the one `gyro frequencies` analyses; never "no equilibrium" where there is one."""
+    rc, out, err = gyro("stability", "gyrohorizoncompass", *args)
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1
+    assert "no relative equilibrium (3.1)" in err and "another equilibrium here" in err
+    beta = float(err.split("beta = ")[1].split(",")[0])
+    rc, out, err2 = gyro("frequencies", "gyrohorizoncompass", *args, "--json")
+    assert rc == 0, err2
+    assert math.isclose(json.loads(out)["equilibrium"]["beta"], beta, rel_tol=1e-5)

@@ -18,16 +18,17 @@ grandchild of the command). Elsewhere, or with one job, the tasks run in this pr
 """
 from __future__ import annotations
 
-import concurrent.futures as cf
-import ctypes
-import multiprocessing as mp
 import os
-import pickle
-import signal
 import sys
 from functools import lru_cache
-from multiprocessing.reduction import ForkingPickler
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
+
+if TYPE_CHECKING:
+    import concurrent.futures as cf
+
+# concurrent.futures, multiprocessing, pickle, ctypes and signal are imported where workers
+# are used, not with the module: with one job (a derivation on one core, the smallest
+# models' whole process) they would be 0.01-0.02 s of import for nothing
 
 _TASK: list[Callable[[int], object]] = []  # the task of the innermost pmap, for the forked workers
 JOBS = 1  # the cores the derivation may use (python -m derive --jobs): where pmap and later take it
@@ -49,6 +50,8 @@ def usable_cores() -> int:
 
 @lru_cache(maxsize=None)
 def _prctl():
+    import ctypes
+
     try:
         fn = ctypes.CDLL(None, use_errno=True).prctl
     except (OSError, AttributeError):
@@ -59,6 +62,8 @@ def _prctl():
 
 def can_fork() -> bool:
     """Workers are used where they can be forked and tied to their parent's life: Linux."""
+    import multiprocessing as mp
+
     return sys.platform.startswith("linux") and "fork" in mp.get_all_start_methods() and _prctl() is not None
 
 
@@ -73,6 +78,9 @@ def _tie_to_parent(parent: int) -> None:
     worker's exit concurrent.futures wakes every pool it knows, and writing to a copy the
     parent has meanwhile closed printed "Exception ignored ... OSError: Bad file descriptor"
     (2 runs in 6 where a model worker was killed beside one that went on)."""
+    import concurrent.futures as cf
+    import signal
+
     _prctl()(_PR_SET_PDEATHSIG, signal.SIGKILL)
     if os.getppid() != parent:
         os._exit(1)
@@ -80,6 +88,9 @@ def _tie_to_parent(parent: int) -> None:
 
 
 def _run(i: int):
+    import pickle
+    from multiprocessing.reduction import ForkingPickler
+
     try:
         return _TASK[-1](i)
     except Exception as exc:
@@ -96,6 +107,9 @@ def _run(i: int):
 
 
 def _pool(workers: int) -> cf.ProcessPoolExecutor:
+    import concurrent.futures as cf
+    import multiprocessing as mp
+
     return cf.ProcessPoolExecutor(workers, mp_context=mp.get_context("fork"),
                                   initializer=_tie_to_parent, initargs=(os.getpid(),))
 
@@ -145,6 +159,8 @@ class later:
     def result(self):
         if not self.beside:
             return self._value
+        import concurrent.futures as cf
+
         try:
             return self._future.result()
         except cf.process.BrokenProcessPool as exc:
@@ -166,6 +182,8 @@ def pmap(task: Callable[[int], object], n: int, jobs: int | None = None, order: 
     jobs = JOBS if jobs is None else jobs
     if jobs <= 1 or n <= 1 or not can_fork():
         return [task(i) for i in range(n)]
+    import concurrent.futures as cf
+
     _TASK.append(task)
     ex = _pool(min(jobs, n))
     done = False

@@ -1,7 +1,8 @@
 """The derivation's process imports no NumPy (derive.mechanics withholds it from symengine's
-import, which would take it for Lambdify alone): 0.06-0.1 s of CPU that the smallest
-models' whole derivation (0.02 s) cannot win back against SymPy's own method
-(bench/sympy_systems.py). The equations are the same either way."""
+import, which would take it for Lambdify alone) and, with one job, none of the workers'
+modules (derive.parallel imports them where workers are used): 0.06-0.1 s and 0.01-0.02 s
+of CPU that the smallest models' whole derivation (0.02 s) cannot win back against SymPy's
+own method (bench/sympy_systems.py). The equations are the same either way."""
 import json
 import subprocess
 import sys
@@ -13,6 +14,7 @@ SCRIPT = """
 import importlib.util, io, json, sys
 from derive import pipeline
 assert "numpy" not in sys.modules, "NumPy imported with the derivation"
+assert "multiprocessing" not in sys.modules, "the workers' modules imported with one job"
 sys.path.insert(0, {folder!r})
 spec = importlib.util.spec_from_file_location("_m", {path!r})
 mod = importlib.util.module_from_spec(spec)

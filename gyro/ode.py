@@ -423,6 +423,49 @@ def two_tolerances(run, rtol: float, finer: float = 1e-2):
     return q2, 2 * np.max(np.abs(q1 - q2), axis=0)
 
 
+SHORTEST = 2.0**-30  # of a sample interval: the shortest piece `projected` runs
+
+
+def projected(fun, t, y0, method: str, rtol: float, atol, kw: dict, project) -> np.ndarray:
+    """States (len(t), size) of solve_ivp's `method` on fun from y0, run in pieces, each
+    piece's end projected (`project`, integrate_state), every sample time the end of one.
+    A piece whose correction is more than its tolerance allows (ratio > 1) is run again,
+    shorter: the drift off a manifold grows with the piece's length, as its square for the
+    index-1 form of a model with constraints (docs/models.md), so the next length is the
+    last times 0.5/sqrt(ratio), within [1/100, 1/2] after a rejected piece and at most
+    twice after an accepted one (a piece cut short by its sample time only shortens it).
+    A piece of SHORTEST of its interval still corrected by more: FloatingPointError."""
+    from scipy.integrate import solve_ivp
+
+    Y = np.empty((t.size, y0.size))
+    Y[0] = y = y0
+    span = math.inf
+    for i in range(1, t.size):
+        a, b = t[i - 1], t[i]
+        while a < b:
+            c = b if b - a <= span else a + span
+            sol = solve_ivp(fun, (a, c), y, method=method, rtol=rtol, atol=atol, **kw)
+            if sol.status != 0:
+                raise FloatingPointError(f"{method} stopped at t = {sol.t[-1]:.6g} s: {sol.message}")
+            y1, ratio = project(sol.y[:, -1], y)
+            if not np.isfinite(ratio):
+                raise FloatingPointError(f"at t = {c:.6g} s the motion cannot be put back on its constraints "
+                                         "(no point of them near it on the branch it started on)")
+            factor = 2.0 if ratio == 0 else 0.5 / math.sqrt(ratio)
+            if ratio > 1.0:
+                if not c - a > (b - a) * SHORTEST:
+                    raise FloatingPointError(
+                        f"the motion leaves its constraints faster than the tolerance allows: from t = {a:.6g} s to "
+                        f"{c:.6g} s the correction back onto them is {ratio:.3g} times what rtol {rtol:g} allows")
+                span = (c - a) * min(max(factor, 0.01), 0.5)
+                continue
+            cut = c == b and c - a < span  # ended by its sample time
+            span = min(span, (c - a) * factor) if cut else (c - a) * min(factor, 2.0)
+            y, a = y1, c
+        Y[i] = y
+    return Y
+
+
 SCIPY_METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")  # DOP853 first: the default
 STIFF = ("Radau", "BDF", "LSODA")  # SciPy's methods that take the Jacobian
 # SUNDIALS through CasADi: the integrator and its options (cvodes-adams: non-stiff
@@ -432,8 +475,8 @@ SUNDIALS = {"cvodes": ("cvodes", {}), "idas": ("idas", {}),
 
 
 def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budget_s: float = math.inf,
-                    budget_steps: float = math.inf, jac: bool = False, inputs=None, label: str | None = None
-                    ) -> np.ndarray:
+                    budget_steps: float = math.inf, jac: bool = False, inputs=None, label: str | None = None,
+                    project=None) -> np.ndarray:
     """States (len(t), 2n) of y' = f(y, P) (the emitted equations of motion; the further
     inputs zero, or for SciPy's methods `inputs(t)` as numpy_rhs takes it) from y0 at t[0],
     at the times t: one integrator for every model's motions; `label` names the run in a
@@ -445,7 +488,13 @@ def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budg
     idas), budget_steps shared out over the output intervals (at least 500 each; SUNDIALS
     counts steps between outputs), its own lines on stderr silenced: IntegrationBudget where
     it gives up (its budget, or a failed step). The budgets are the command line's; a library
-    call without them runs to the end."""
+    call without them runs to the end.
+
+    `project` (SciPy's methods): a map onto a manifold the motion keeps (a model's holonomic
+    constraints and their rates, gyro.analyses.motion.Constraints), project(y, y_before) ->
+    (the point on it, the correction's size in units of what the tolerance allows of each
+    component, atol + rtol max(|y|, |y_before|)): the run then goes from one sample time to
+    the next (`projected`), each end projected."""
     import casadi as ca
 
     t = np.asarray(t, float)
@@ -464,6 +513,8 @@ def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budg
             fun = WATCH.wrap(fun, t[0], t[-1])
         try:
             with np.errstate(all="ignore"):
+                if project is not None:
+                    return projected(fun, t, y0, method, rtol, atol, kw, project)
                 sol = solve_ivp(fun, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol, **kw)
         finally:
             if hasattr(fun, "done"):

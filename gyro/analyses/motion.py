@@ -29,11 +29,103 @@ IntegrationBudget = ode.IntegrationBudget  # the one type (gyro/ode.py)
 
 @dataclass
 class Start:
-    """Where a motion starts: the reference state, the offsets, and the state itself."""
+    """Where a motion starts: the reference state, the offsets, and the state itself; for a
+    model with multipliers its `constraints` (Constraints), and the coordinates and rates
+    `solved` from them."""
     q_ref: np.ndarray
     qd_ref: np.ndarray
     y0: np.ndarray
     equilibrium: dict
+    constraints: "Constraints | None" = None
+    solved: tuple = ()
+
+
+def carried(model) -> dict | None:
+    """The metadata 'constraints' of a model whose holonomic constraints are carried by
+    multipliers, else None."""
+    c = model.meta.get("constraints") or {}
+    return c if c.get("multipliers") else None
+
+
+class Constraints:
+    """The holonomic constraints of a model with multipliers about one reference q_ref, from
+    the emitted quantity `constraints` (phi(q) and Phi_q = dphi/dq) and the metadata's
+    `dependent` coordinates: `position(q)` keeps q's independent coordinates and solves the
+    dependent ones from phi(q) = 0 by Newton's method from their values in q
+    (gyro.equilibrium.on_constraints, that start alone), on the reference's branch (the
+    sign of det dphi/dq_dep as at q_ref: another branch lies past a point where it
+    vanishes); `rates(q, qd)` solves the dependent rates from Phi_q q' = 0; `project(y,
+    y_before)` does both to a state and measures the corrections against the integrator's
+    tolerance (ode.integrate_state's `project`), the largest accepted one kept per
+    dependent coordinate and rate (`drift`)."""
+
+    def __init__(self, model, P, q_ref, rtol: float = 0.0, atol=0.0):
+        meta = model.meta
+        c = carried(model)
+        self.model, self.P = model, np.asarray(P, float)
+        self.coords = list(meta["coordinates"])
+        if list(meta["equilibrium_coordinates"]) != self.coords:  # on_constraints' layout
+            raise ParameterError(f"{model.name}: its multipliers come with coordinates that have no equilibrium "
+                                 f"({', '.join(c for c in self.coords if c not in meta['equilibrium_coordinates'])})"
+                                 ": its constraints are not solved for a motion")
+        self.dependent, self.independent = list(c["dependent"]), list(c["independent"])
+        self.dep = np.array([self.coords.index(x) for x in self.dependent], int)
+        self.ind = np.array([self.coords.index(x) for x in self.independent], int)
+        self.nq = len(self.coords)
+        units = meta.get("coordinate_units", {})
+        self.is_angle = np.array([units.get(x) == "rad" for x in self.coords], bool)
+        self.rtol, self.atol = rtol, atol
+        self.branch = self._sign(np.asarray(q_ref, float))
+        self.drift = np.zeros(2 * len(self.dep))  # the largest accepted corrections, q_dep then q_dep'
+
+    def _evaluate(self, q):
+        with np.errstate(all="ignore"):
+            phi, J = function(self.model, "constraints")(self.P[None], np.asarray(q, float)[None])
+        return np.asarray(phi, float).reshape(-1), np.asarray(J, float).reshape(len(self.dep), self.nq)
+
+    def _sign(self, q) -> float:
+        J = self._evaluate(q)[1]
+        return float(np.sign(np.linalg.det(J[:, self.dep]))) if np.all(np.isfinite(J)) else 0.0
+
+    def position(self, q) -> np.ndarray | None:
+        """q with its dependent coordinates solved from phi = 0 on the reference's branch, or
+        None where Newton's method from them meets no point of it."""
+        from gyro.equilibrium import on_constraints
+
+        out = on_constraints(self.model, self.P[None], np.asarray(q, float)[None], self.is_angle,
+                             starts=(None,))[0]
+        phi = self._evaluate(out)[0]
+        met = np.all(np.isfinite(out)) and np.max(np.abs(phi)) <= 1e-12 * max(1.0, float(np.max(np.abs(out))))
+        return out if met and self.branch != 0 and self._sign(out) == self.branch else None
+
+    def rates(self, q, qd) -> np.ndarray:
+        """qd with its dependent rates from Phi_q q' = 0 at q (its independent rates as given)."""
+        J = self._evaluate(q)[1]
+        out = np.array(qd, float)
+        out[self.dep] = np.linalg.solve(J[:, self.dep], -J[:, self.ind] @ out[self.ind]) + 0.0  # no -0
+        return out
+
+    def project(self, y, before):
+        """(y on the constraints, the largest correction over what the tolerance allows of its
+        component, atol + rtol max(|y|, |before|)); inf where position() finds no point."""
+        n = self.nq
+        q = self.position(y[:n])
+        if q is None:
+            return y, np.inf
+        out = np.concatenate([q, self.rates(q, y[n:])])
+        rows = np.concatenate([self.dep, n + self.dep])
+        change = np.abs(out[rows] - y[rows])
+        allowed = (np.broadcast_to(self.atol, y.shape)[rows]
+                   + self.rtol * np.maximum(np.abs(y[rows]), np.abs(before[rows])))
+        with np.errstate(all="ignore"):
+            ratio = float(np.max(np.where(change == 0, 0.0, change / allowed), initial=0.0))
+        if ratio <= 1.0:
+            self.drift = np.maximum(self.drift, change)
+        return out, ratio
+
+    def residual(self, Y) -> np.ndarray:
+        """The largest |phi| over the states Y (times, 2 nq), per constraint."""
+        return np.max(np.abs([self._evaluate(y[:self.nq])[0] for y in Y]), axis=0)
 
 
 def perturbations(model, items: dict) -> dict:
@@ -43,11 +135,18 @@ def perturbations(model, items: dict) -> dict:
 
     coords = list(model.meta["coordinates"])
     known = coords + [f"{c}_d" for c in coords]
+    c = carried(model)
+    dependent = c["dependent"] if c else []
     out = {}
     for name, raw in items.items():
         if name not in known:
             raise ParameterError(f"--perturb {name}: not a coordinate of {model.name} nor a rate NAME_d; "
                                  f"known: {' '.join(known)}")
+        if name.removesuffix("_d") in dependent:
+            free = c["independent"] + [f"{x}_d" for x in c["independent"]]
+            raise ParameterError(f"--perturb {name}: {name.removesuffix('_d')} is a dependent coordinate of "
+                                 f"{model.name}, solved from its constraints at the start; offset the independent "
+                                 f"ones: {' '.join(free)}")
         out[name] = finite_number(f"--perturb {name}", raw)
     return out
 
@@ -89,7 +188,18 @@ def start(model, P, offsets: dict, qe: np.ndarray | None = None) -> Start:
             q0[coords.index(name)] += value
         else:
             qd0[coords.index(name[:-2])] += value
-    return Start(q_ref, qd_ref, np.concatenate([q0, qd0]), dict(zip(eq_names, map(float, qe[0]))))
+    equilibrium = dict(zip(eq_names, map(float, qe[0])))
+    if not carried(model):
+        return Start(q_ref, qd_ref, np.concatenate([q0, qd0]), equilibrium)
+    cons = Constraints(model, P[0], q_ref, RTOL, ATOL)
+    q1 = cons.position(q0)
+    if q1 is None:
+        given = [k for k in offsets if k in coords]
+        raise ParameterError(f"--perturb {' '.join(given)}: no point of {model.name}'s constraints near its "
+                             f"reference has {' and '.join(f'{k} = {q0[coords.index(k)]:g}' for k in given)} "
+                             f"({', '.join(cons.dependent)} solved from them on the reference's branch)")
+    solved = tuple(cons.dependent) + tuple(f"{x}_d" for x in cons.dependent)
+    return Start(q_ref, qd_ref, np.concatenate([q1, cons.rates(q1, qd0)]), equilibrium, cons, solved)
 
 
 # the linear motion's fine grid, its samples times the states at the most (some 80 MB an
@@ -147,41 +257,64 @@ def simulate(model, values: dict, offsets: dict, t: np.ndarray, method: str = "D
                              f"integration would need about {need:.2g} evaluations of the equations, over its budget of "
                              f"{BUDGET_EVALUATIONS:.0e}: a shorter horizon")
     t0 = time.perf_counter()
+    cons = st.constraints
     Y = ode.integrate_state(model, P, st.y0, t, method, RTOL, ATOL, budget_s, BUDGET_EVALUATIONS,
-                            inputs=_inputs(model), label=f"{method} on {model.name}")
+                            inputs=_inputs(model), label=f"{method} on {model.name}",
+                            project=cons.project if cons else None)
     if not np.all(np.isfinite(Y)):
         raise FloatingPointError("a coordinate is not finite along the motion")
     n = len(model.meta["coordinates"])
+    extra = {}
+    if cons:
+        names = [*cons.dependent, *(f"{x}_d" for x in cons.dependent)]
+        extra = {"start": dict(zip([*cons.coords, *(f"{x}_d" for x in cons.coords)], map(float, st.y0))),
+                 "solved": list(st.solved), "constraint_residual": dict(zip(names, map(float, cons.drift)))}
     return coordinate_motion(model, method, t, Y[:, :n], Y[:, n:], dict(values), dict(offsets), st.equilibrium,
-                             time.perf_counter() - t0)
+                             time.perf_counter() - t0, extra)
 
 
 # the generic motion's document: these keys, then each coordinate not among them
 HEAD = ["model", "method", "params", "perturb", "equilibrium", "coordinates", "units", "t", "rates", "seconds"]
 
 
+# and, for a model with multipliers, these after them
+CONSTRAINED = ["start", "solved", "constraint_residual"]
+
+
 def coordinate_motion(model, method: str, t, q, qd, params: dict, perturb: dict, equilibrium: dict,
-                      seconds: float = 0.0):
+                      seconds: float = 0.0, constrained: dict | None = None):
     """A motion of any model in its coordinates, as gyro.results.Motion: q and qd (times,
     coordinates) absolute values in the model's units, the series the coordinates and their
     rates NAME_d; the `gyro simulate --json` document of the generic motion: `t`, one list
     per coordinate under its name, `method`, and `rates` ({NAME_d: list}), `coordinates`,
     `units`, `params`, `perturb`, `equilibrium`, `model`, `seconds` (a model file's motion
-    of its own may give its own in the same form: tests/models/oscillator_own_motion.py)."""
+    of its own may give its own in the same form: tests/models/oscillator_own_motion.py).
+    A model with multipliers adds `constrained` (CONSTRAINED): `start`, the state at t = 0
+    ({NAME: value, NAME_d: value}), `solved`, which of them were solved from the
+    constraints, and `constraint_residual` ({NAME: largest, NAME_d: largest} over the
+    dependent coordinates and rates: the largest correction that put the integrated state
+    back onto the constraints, each within the integrator's tolerance; the states given
+    are on them to Newton's rounding)."""
     from gyro.results import Motion
 
     coords = list(model.meta["coordinates"])
     units = [model.meta.get("coordinate_units", {}).get(c, "") for c in coords]
     rates = [f"{c}_d" for c in coords]
     title = model.meta.get("title", model.name)
-    heading = (f"{title} ({model.name}), method {method}, from the reference"
-               + (" with " + ", ".join(f"{k} {v:+g}" for k, v in perturb.items()) if perturb else ""))
+    heading = [f"{title} ({model.name}), method {method}, from the reference"
+               + (" with " + ", ".join(f"{k} {v:+g}" for k, v in perturb.items()) if perturb else "")]
     info = {"params": params, "perturb": perturb, "equilibrium": equilibrium, "coordinates": coords,
-            "units": dict(zip(coords, units)), "seconds": seconds}
+            "units": dict(zip(coords, units)), "seconds": seconds, **(constrained or {})}
+    if constrained:
+        start = constrained["start"]
+        heading.append("on the constraints: " + ", ".join(f"{k} = {start[k]:.9g}" for k in constrained["solved"])
+                       + " solved at the start; projected back along the motion by at most "
+                       + ", ".join(f"{k} {v:.2g}" for k, v in constrained["constraint_residual"].items()))
+    head = HEAD + (CONSTRAINED if constrained else [])
     return Motion(model.name, title, method, np.asarray(t), coords + rates, np.hstack([q, qd]),
                   units + [f"{u}/s" if u else "1/s" for u in units],
                   [f"the coordinate {c}" for c in coords] + [f"the rate of {c}" for c in coords], info=info,
-                  keys=HEAD + [c for c in coords if c not in HEAD], groups={"rates": rates}, heading=[heading],
+                  keys=head + [c for c in coords if c not in head], groups={"rates": rates}, heading=heading,
                   shown=coords, formats={"t": ">12.6g", **{c: ">16.9g" for c in coords}}, gap="")
 
 

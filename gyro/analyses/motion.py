@@ -78,6 +78,14 @@ class Constraints:
         self.branch = self._sign(np.asarray(q_ref, float))
         self.drift = np.zeros(2 * len(self.dep))  # the largest accepted corrections, q_dep then q_dep'
 
+    def tolerance(self, rtol: float, atol) -> "Constraints":
+        """These constraints projecting against another tolerance, their drift from zero."""
+        import copy
+
+        out = copy.copy(self)
+        out.rtol, out.atol, out.drift = rtol, atol, np.zeros_like(self.drift)
+        return out
+
     def _evaluate(self, q):
         with np.errstate(all="ignore"):
             phi, J = function(self.model, "constraints")(self.P[None], np.asarray(q, float)[None])
@@ -327,16 +335,15 @@ class ReducedState:
     and rate offsets xd: q = q_ref + x and q' = qd_ref + xd on the reduced coordinates (a
     steady coordinate keeps its declared rate plus xd), the cyclic coordinates' rates from
     their momenta (the emitted `cyclic_rates`: for the torsion gyrocompass gamma3' from the
-    integral C r2 = H, (2.3))."""
+    integral C r2 = H, (2.3)). A model with multipliers: the reduced coordinates are the
+    independent ones, the dependent coordinates and rates solved from the constraints on the
+    reference's branch (`constraints`, Constraints; with lib = casadi by CasADi's Newton
+    rootfinder, the rates by the linear solve: an implicit map, exact to its tolerance)."""
 
     def __init__(self, model, values: dict):
         from gyro.equilibrium import equilibrium
 
         meta = model.meta
-        if meta.get("constraints", {}).get("multipliers"):
-            raise ParameterError(f"{model.name}: its constraints are carried by multipliers: the reduced motion "
-                                 "(offsets of the independent coordinates alone) would leave them; not built for "
-                                 "such a model (gyro simulate integrates its full equations)")
         if any(i["name"] == "time" for i in meta["functions"]["forcing"]["inputs"]):
             raise ParameterError(f"{model.name}: its equations hold the time explicitly: no reduced motion about "
                                  "a reference (the linear motion needs autonomous equations)")
@@ -350,12 +357,18 @@ class ReducedState:
         self.nq, self.n = len(self.coords), len(self.ri)
         st = start(model, self.P, {}, self.qe)
         self.q_ref, self.qd_ref = st.q_ref, st.qd_ref
+        self.constraints = st.constraints
+        if self.constraints is not None and list(self.constraints.ind) != list(self.ri):
+            raise ParameterError(f"{model.name}: its reduced coordinates ({', '.join(meta['reduced'])}) are not its "
+                                 f"independent ones ({', '.join(self.constraints.independent)})")
         if self.ci and "cyclic_rates" not in meta["functions"]:
             raise ParameterError(f"{model.name}: emitted without cyclic_rates (derive it again with this version)")
 
     def state(self, x, xd, lib=np):
         """The full state (q, q') of reduced displacements x and rate offsets xd; with
-        lib = casadi, of symbols (an SX column)."""
+        lib = casadi, of symbols (an SX column; MX for a model with multipliers)."""
+        if self.constraints is not None:
+            return self._constrained_state(x, xd, lib)
         if lib is np:
             q, qd = self.q_ref.copy(), self.qd_ref.copy()
             q[self.ri] += x
@@ -373,6 +386,65 @@ class ReducedState:
             for j, i in enumerate(self.ci):
                 qd[i] = rates[j]
         return lib.vertcat(*q, *qd)
+
+    def _constrained_state(self, x, xd, lib):
+        """state() of a model with multipliers: the independent coordinates and rates offset,
+        the dependent ones solved (Constraints; with lib = casadi the rootfinder, `_dependent`)."""
+        cons = self.constraints
+        if lib is np:
+            q, qd = self.q_ref.copy(), self.qd_ref.copy()
+            q[self.ri] += x
+            qd[self.ri] += xd
+            q1 = cons.position(q)
+            if q1 is None:
+                raise ParameterError(f"{self.model.name}: no point of its constraints near the reference has "
+                                     + ", ".join(f"{self.coords[i]} = {q[i]:g}" for i in self.ri)
+                                     + f" ({', '.join(cons.dependent)} solved on the reference's branch)")
+            return np.concatenate([q1, cons.rates(q1, qd)])
+        ind = lib.vertcat(*[float(self.q_ref[i]) + x[j] for j, i in enumerate(self.ri)])
+        rates = lib.vertcat(*[float(self.qd_ref[i]) + xd[j] for j, i in enumerate(self.ri)])
+        dep = self._dependent(lib.DM(self.q_ref[cons.dep]), ind)
+        q = [None] * self.nq
+        for j, i in enumerate(self.ri):
+            q[i] = ind[j]
+        for j, i in enumerate(cons.dep):
+            q[i] = dep[j]
+        q = lib.vertcat(*q)
+        J = self.model.casadi.constraints(lib.DM(self.P), q)[1]
+        dep_rates = -lib.solve(J[:, list(cons.dep)], J[:, list(self.ri)] @ rates)
+        qd = [None] * self.nq
+        for j, i in enumerate(self.ri):
+            qd[i] = rates[j]
+        for j, i in enumerate(cons.dep):
+            qd[i] = dep_rates[j]
+        return lib.vertcat(q, *qd)
+
+    @cached_property
+    def _dependent(self):
+        """CasADi's Newton rootfinder (guess, independent coordinates) -> the dependent
+        coordinates on phi = 0, from the reference's values: the offsets a reduced motion
+        takes are small (CAP), so the reference's branch. Its residual tolerance 1e-14 of
+        the constraints' terms at the reference (|Phi_q| |q|; phi's rounding is some 1e-16 of
+        them), its step tolerance 1e-15 of the coordinates' size; a Newton that
+        does not converge raises (error_on_fail), never an unconverged point."""
+        import casadi as ca
+
+        cons = self.constraints
+        guess = ca.SX.sym("dependent", len(cons.dep))
+        ind = ca.SX.sym("independent", self.n)
+        q = [None] * self.nq
+        for j, i in enumerate(self.ri):
+            q[i] = ind[j]
+        for j, i in enumerate(cons.dep):
+            q[i] = guess[j]
+        phi = self.model.casadi.constraints(ca.DM(self.P), ca.vertcat(*q))[0]
+        J = cons._evaluate(self.q_ref)[1]
+        terms = float(np.max(np.abs(J) @ np.abs(self.q_ref)))
+        terms = terms if terms > 0 else 1.0
+        size = max(1.0, float(np.max(np.abs(self.q_ref))))
+        G = ca.Function("constraints_dependent", [guess, ind], [phi])
+        return ca.rootfinder("dependent", "newton", G, {"error_on_fail": True, "abstol": 1e-14 * terms,
+                                                        "abstolStep": 1e-15 * size, "max_iter": 50})
 
     def state_jacobian(self, Y: np.ndarray) -> np.ndarray:
         """d state / d (x, xd) at full states Y (2 nq, N): (N, 2 nq, 2 n): the identity on the
@@ -414,10 +486,15 @@ class ReducedState:
         import casadi as ca
 
         sym = ode.symbolic(self.model)
-        z = ca.SX.sym("z", 2 * self.n)
-        Y = self.state(ca.vertsplit(z[:self.n]), ca.vertsplit(z[self.n:]), ca)
-        ydot = ca.substitute([sym.ydot], [sym.y, sym.p, *sym.inputs],
-                             [Y, ca.DM(self.P), *[ca.DM.zeros(v.numel()) for v in sym.inputs]])[0]
+        zeros = [ca.DM.zeros(v.numel()) for v in sym.inputs]
+        if self.constraints is not None:  # the state through a rootfinder: MX, the equations as a call
+            z = ca.MX.sym("z", 2 * self.n)
+            Y = self.state(ca.vertsplit(z[:self.n]), ca.vertsplit(z[self.n:]), ca)
+            ydot = ode.rhs(self.model)(Y, ca.DM(self.P), *zeros)
+        else:
+            z = ca.SX.sym("z", 2 * self.n)
+            Y = self.state(ca.vertsplit(z[:self.n]), ca.vertsplit(z[self.n:]), ca)
+            ydot = ca.substitute([sym.ydot], [sym.y, sym.p, *sym.inputs], [Y, ca.DM(self.P), *zeros])[0]
         return ca.Function("reduced_rhs", [z], [ca.vertcat(z[self.n:], ydot[self.nq + self.ri])])
 
 
@@ -550,7 +627,9 @@ def integrate_reduced(red: ReducedState, z0: np.ndarray, t, method: str = "DOP85
     sets the absolute tolerances, 1e-3 rtol of it (default: the linear motion's largest |x|,
     |x'|), so a small perturbation is resolved, but not below `floor` eps of the reference's
     largest coordinate (and that times the fastest frequency for the rates): there the
-    state's rounding, amplified by stiff springs, would stall the steps."""
+    state's rounding, amplified by stiff springs, would stall the steps. A model with
+    multipliers: projected onto its constraints (Constraints.project) at each sample time
+    and wherever its drift comes near the tolerance (ode.projected)."""
 
     t = np.asarray(t, float)
     n = red.n
@@ -563,7 +642,9 @@ def integrate_reduced(red: ReducedState, z0: np.ndarray, t, method: str = "DOP85
     atol = np.empty(2 * red.nq)
     atol[:red.nq] = max(1e-3 * rtol * scale[0], lo, np.finfo(float).tiny)
     atol[red.nq:] = max(1e-3 * rtol * scale[1], lo * w_max, np.finfo(float).tiny)
-    Y = ode.integrate_state(red.model, red.P, red.state(z0[:n], z0[n:]), t, method, rtol, atol)
+    cons = red.constraints
+    project = cons.tolerance(rtol, atol).project if cons is not None else None
+    Y = ode.integrate_state(red.model, red.P, red.state(z0[:n], z0[n:]), t, method, rtol, atol, project=project)
     return Y[:, red.ri]
 
 

@@ -316,8 +316,9 @@ def coordinate_motion(model, method: str, t, q, qd, params: dict, perturb: dict,
     if constrained:
         start = constrained["start"]
         heading.append("on the constraints: " + ", ".join(f"{k} = {start[k]:.9g}" for k in constrained["solved"])
-                       + " solved at the start; projected back along the motion by at most "
-                       + ", ".join(f"{k} {v:.2g}" for k, v in constrained["constraint_residual"].items()))
+                       + " solved at the start; the largest correction back onto them along the motion: "
+                       + ", ".join(f"{k} {v:.2g}" for k, v in constrained["constraint_residual"].items())
+                       + " (each within its tolerance)")
     head = HEAD + (CONSTRAINED if constrained else [])
     return Motion(model.name, title, method, np.asarray(t), coords + rates, np.hstack([q, qd]),
                   units + [f"{u}/s" if u else "1/s" for u in units],

@@ -525,6 +525,8 @@ def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budg
                                      f"{sol.message}")
         return sol.y.T
     if method in SUNDIALS:
+        if project is not None:
+            raise ValueError(f"{method}: a run projected onto constraints is SciPy's methods' only")
         if inputs is not None:
             raise ValueError(f"{method}: the equations' time-varying inputs are SciPy's methods' only")
         name, extra = SUNDIALS[method]

@@ -302,7 +302,7 @@ def coordinate_motion(model, method: str, t, q, qd, params: dict, perturb: dict,
     constraints, and `constraint_residual` ({NAME: largest, NAME_d: largest} over the
     dependent coordinates and rates: the largest correction that put the integrated state
     back onto the constraints, each within the integrator's tolerance; the states given
-    are on them to Newton's rounding)."""
+    are on them to Newton's rounding); the text's second line says so."""
     from gyro.results import Motion
 
     coords = list(model.meta["coordinates"])
@@ -316,9 +316,8 @@ def coordinate_motion(model, method: str, t, q, qd, params: dict, perturb: dict,
     if constrained:
         start = constrained["start"]
         heading.append("on the constraints: " + ", ".join(f"{k} = {start[k]:.9g}" for k in constrained["solved"])
-                       + " solved at the start; the largest correction back onto them along the motion: "
-                       + ", ".join(f"{k} {v:.2g}" for k, v in constrained["constraint_residual"].items())
-                       + " (each within its tolerance)")
+                       + " solved at the start; put back onto them along the motion, each correction within "
+                       "the tolerance (the largest: constraint_residual)")
     head = HEAD + (CONSTRAINED if constrained else [])
     return Motion(model.name, title, method, np.asarray(t), coords + rates, np.hstack([q, qd]),
                   units + [f"{u}/s" if u else "1/s" for u in units],

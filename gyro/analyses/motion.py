@@ -397,9 +397,10 @@ class ReducedState:
             qd[self.ri] += xd
             q1 = cons.position(q)
             if q1 is None:
-                raise ParameterError(f"{self.model.name}: no point of its constraints near the reference has "
-                                     + ", ".join(f"{self.coords[i]} = {q[i]:g}" for i in self.ri)
-                                     + f" ({', '.join(cons.dependent)} solved on the reference's branch)")
+                raise ParameterError(f"--set {' '.join(f'{self.coords[i]}_0' for i in self.ri)}: no point of "
+                                     f"{self.model.name}'s constraints near its reference has "
+                                     + " and ".join(f"{self.coords[i]} = {q[i]:g}" for i in self.ri)
+                                     + f" ({', '.join(cons.dependent)} solved from them on the reference's branch)")
             return np.concatenate([q1, cons.rates(q1, qd)])
         ind = lib.vertcat(*[float(self.q_ref[i]) + x[j] for j, i in enumerate(self.ri)])
         rates = lib.vertcat(*[float(self.qd_ref[i]) + xd[j] for j, i in enumerate(self.ri)])
@@ -605,7 +606,7 @@ def _remainder(red: ReducedState, z: np.ndarray, f, what: str) -> np.ndarray:
     39000 samples)."""
     watch = ode.WATCH
     if watch is None or z.shape[0] <= CHUNK:
-        return np.asarray(f(z.T)).T
+        return _evaluated(red, f, z)
     tick, finished = watch.meter(what)
     out = np.empty_like(z)
     each = red.rhs.map(CHUNK)
@@ -613,11 +614,28 @@ def _remainder(red: ReducedState, z: np.ndarray, f, what: str) -> np.ndarray:
         for s in range(0, z.shape[0], CHUNK):
             block = z[s:s + CHUNK]
             g = each if block.shape[0] == CHUNK else red.rhs.map(block.shape[0])
-            out[s:s + CHUNK] = np.asarray(g(block.T)).T
+            out[s:s + CHUNK] = _evaluated(red, g, block)
             tick((s + block.shape[0]) / z.shape[0])
     finally:
         finished()
     return out
+
+
+def _evaluated(red: ReducedState, f, z: np.ndarray) -> np.ndarray:
+    """f (a map of red.rhs) over the samples z (rows). For a model with multipliers its
+    rootfinder may meet no point of the constraints (a linear motion that swings past their
+    reach): one line saying where, CasADi's dump of the inputs kept off stderr."""
+    if red.constraints is None:
+        return np.asarray(f(z.T)).T
+    try:
+        with ode.stderr_silenced():
+            return np.asarray(f(z.T)).T
+    except RuntimeError:
+        x = z[np.argmax(np.max(np.abs(z[:, :red.n]), axis=1)), :red.n]
+        at = ", ".join(f"{red.coords[i]} = {red.q_ref[i] + v:.6g}" for i, v in zip(red.ri, x))
+        raise FloatingPointError(f"the linear motion reaches {at}, where Newton's method finds no point of the "
+                                 f"constraints for {', '.join(red.constraints.dependent)} on the reference's "
+                                 "branch") from None
 
 
 def integrate_reduced(red: ReducedState, z0: np.ndarray, t, method: str = "DOP853", rtol: float = 1e-9,
@@ -778,10 +796,17 @@ def motion_answer(red: ReducedState, z0: np.ndarray, t, units: list, method: str
     twice the finer run's tolerance on the coordinates' size (an error the two runs share
     where both sit at the absolute tolerance's floor)."""
     t = np.asarray(t, float)
+    if red.constraints is not None:  # a start the constraints cannot meet: bad input, before any work
+        red.state(z0[:red.n], z0[red.n:])
     if method == "linear":
         return linear_answer(red, z0, t, units, cap_of=cap_of)
     n = red.n
-    zL = linear_motion(red, z0, t, CORRECTIONS, FINE)[0]
+    try:
+        zL = linear_motion(red, z0, t, CORRECTIONS, FINE)[0]
+    except FloatingPointError:  # its correction past the constraints' reach (_evaluated): the scale needs none
+        if red.constraints is None:
+            raise
+        zL = linear_motion(red, z0, t, corrections=0)[0]
     scale = np.array([np.max(np.abs(zL[:, :n])), np.max(np.abs(zL[:, n:]))])
     q, est = ode.two_tolerances(lambda r: integrate_reduced(red, z0, t, method, r, scale, FLOOR), rtol, FINER)
     return q, np.maximum(est, integration_floor(group_max(np.max(np.abs(q), axis=0), units), rtol))

@@ -55,9 +55,10 @@ class Constraints:
     (gyro.equilibrium.on_constraints, that start alone), on the reference's branch (the
     sign of det dphi/dq_dep as at q_ref: another branch lies past a point where it
     vanishes); `rates(q, qd)` solves the dependent rates from Phi_q q' = 0; `project(y,
-    y_before)` does both to a state and measures the corrections against the integrator's
-    tolerance (ode.integrate_state's `project`), the largest accepted one kept per
-    dependent coordinate and rate (`drift`)."""
+    y_before)` puts a state of the motion back onto phi = 0 and Phi_q q' = 0 (the nearest
+    point, `nearest`) and measures the corrections against the integrator's tolerance
+    (ode.integrate_state's `project`), the largest accepted one kept per coordinate and rate
+    (`drift`)."""
 
     def __init__(self, model, P, q_ref, rtol: float = 0.0, atol=0.0):
         meta = model.meta
@@ -76,7 +77,7 @@ class Constraints:
         self.is_angle = np.array([units.get(x) == "rad" for x in self.coords], bool)
         self.rtol, self.atol = rtol, atol
         self.branch = self._sign(np.asarray(q_ref, float))
-        self.drift = np.zeros(2 * len(self.dep))  # the largest accepted corrections, q_dep then q_dep'
+        self.drift = np.zeros(2 * self.nq)  # the largest accepted corrections, q then q'
 
     def tolerance(self, rtol: float, atol) -> "Constraints":
         """These constraints projecting against another tolerance, their drift from zero."""
@@ -113,18 +114,42 @@ class Constraints:
         out[self.dep] = np.linalg.solve(J[:, self.dep], -J[:, self.ind] @ out[self.ind]) + 0.0  # no -0
         return out
 
+    def nearest(self, q) -> np.ndarray | None:
+        """The point of the constraints nearest q (Newton's method with the least-norm step,
+        dq = Phi_q' (Phi_q Phi_q')^-1 phi, over all coordinates: it needs no partition, so it
+        holds where the dependent block is singular, a bead at its hoop's equator), or None
+        where it meets none (phi within 1e-12 of the coordinates' size, as `position`)."""
+        q = np.array(q, float)
+        for _ in range(20):
+            phi, J = self._evaluate(q)
+            with np.errstate(all="ignore"):
+                try:
+                    step = J.T @ np.linalg.solve(J @ J.T, phi)
+                except np.linalg.LinAlgError:
+                    return None
+            if not np.all(np.isfinite(step)):
+                return None
+            q -= step
+            if np.max(np.abs(step), initial=0.0) <= 4 * np.finfo(float).eps * max(1.0, float(np.max(np.abs(q)))):
+                break
+        phi = self._evaluate(q)[0]
+        return q if np.max(np.abs(phi)) <= 1e-12 * max(1.0, float(np.max(np.abs(q)))) else None
+
     def project(self, y, before):
         """(y on the constraints, the largest correction over what the tolerance allows of its
-        component, atol + rtol max(|y|, |before|)); inf where position() finds no point."""
+        component, atol + rtol max(|y|, |before|)); inf where `nearest` finds no point. The
+        coordinates to the nearest point of phi = 0, the rates to the nearest of Phi_q q' = 0
+        there (q' - Phi_q' (Phi_q Phi_q')^-1 Phi_q q'): the standard orthogonal projection,
+        which follows the motion onto any branch it swings to (a bead over its hoop's top)."""
         n = self.nq
-        q = self.position(y[:n])
+        q = self.nearest(y[:n])
         if q is None:
             return y, np.inf
-        out = np.concatenate([q, self.rates(q, y[n:])])
-        rows = np.concatenate([self.dep, n + self.dep])
-        change = np.abs(out[rows] - y[rows])
-        allowed = (np.broadcast_to(self.atol, y.shape)[rows]
-                   + self.rtol * np.maximum(np.abs(y[rows]), np.abs(before[rows])))
+        J = self._evaluate(q)[1]
+        qd = y[n:] - J.T @ np.linalg.solve(J @ J.T, J @ y[n:])
+        out = np.concatenate([q, qd])
+        change = np.abs(out - y)
+        allowed = np.broadcast_to(self.atol, y.shape) + self.rtol * np.maximum(np.abs(y), np.abs(before))
         with np.errstate(all="ignore"):
             ratio = float(np.max(np.where(change == 0, 0.0, change / allowed), initial=0.0))
         if ratio <= 1.0:
@@ -274,9 +299,9 @@ def simulate(model, values: dict, offsets: dict, t: np.ndarray, method: str = "D
     n = len(model.meta["coordinates"])
     extra = {}
     if cons:
-        names = [*cons.dependent, *(f"{x}_d" for x in cons.dependent)]
-        extra = {"start": dict(zip([*cons.coords, *(f"{x}_d" for x in cons.coords)], map(float, st.y0))),
-                 "solved": list(st.solved), "constraint_residual": dict(zip(names, map(float, cons.drift)))}
+        names = [*cons.coords, *(f"{x}_d" for x in cons.coords)]
+        extra = {"start": dict(zip(names, map(float, st.y0))), "solved": list(st.solved),
+                 "constraint_residual": dict(zip(names, map(float, cons.drift)))}
     return coordinate_motion(model, method, t, Y[:, :n], Y[:, n:], dict(values), dict(offsets), st.equilibrium,
                              time.perf_counter() - t0, extra)
 
@@ -300,9 +325,9 @@ def coordinate_motion(model, method: str, t, q, qd, params: dict, perturb: dict,
     A model with multipliers adds `constrained` (CONSTRAINED): `start`, the state at t = 0
     ({NAME: value, NAME_d: value}), `solved`, which of them were solved from the
     constraints, and `constraint_residual` ({NAME: largest, NAME_d: largest} over the
-    dependent coordinates and rates: the largest correction that put the integrated state
-    back onto the constraints, each within the integrator's tolerance; the states given
-    are on them to Newton's rounding); the text's second line says so."""
+    coordinates and rates: the largest correction that put the integrated state back onto
+    the constraints, each within the integrator's tolerance; the states given are on them
+    to Newton's rounding); the text's second line says so."""
     from gyro.results import Motion
 
     coords = list(model.meta["coordinates"])

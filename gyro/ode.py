@@ -442,6 +442,8 @@ def projected(fun, t, y0, method: str, rtol: float, atol, kw: dict, project) -> 
 
     Y = np.empty((t.size, y0.size))
     Y[0] = y = y0
+    if t.size < 2:
+        return Y
     span = (t[1] - t[0]) / FIRST  # doubled while the corrections are small: a few pieces at most
     for i in range(1, t.size):
         a, b = t[i - 1], t[i]
@@ -453,7 +455,7 @@ def projected(fun, t, y0, method: str, rtol: float, atol, kw: dict, project) -> 
             y1, ratio = project(sol.y[:, -1], y)
             if not np.isfinite(ratio):
                 raise FloatingPointError(f"at t = {c:.6g} s the motion cannot be put back on its constraints "
-                                         "(no point of them near it on the branch it started on)")
+                                         "(Newton's method meets no point of them from there)")
             factor = 2.0 if ratio == 0 else 0.5 / math.sqrt(ratio)
             if ratio > 1.0:
                 if not c - a > (b - a) * SHORTEST:

@@ -156,10 +156,6 @@ class Constraints:
             self.drift = np.maximum(self.drift, change)
         return out, ratio
 
-    def residual(self, Y) -> np.ndarray:
-        """The largest |phi| over the states Y (times, 2 nq), per constraint."""
-        return np.max(np.abs([self._evaluate(y[:self.nq])[0] for y in Y]), axis=0)
-
 
 def perturbations(model, items: dict) -> dict:
     """{name: value} of --perturb NAME=VALUE, checked: a coordinate or NAME_d, a finite

@@ -423,6 +423,27 @@ def two_tolerances(run, rtol: float, finer: float = 1e-2):
     return q2, 2 * np.max(np.abs(q1 - q2), axis=0)
 
 
+# SciPy's multistep methods: a restart costs them their history (BDF restarted every 1e-4 s
+# at rtol 1e-10 still corrects by 0.7 of the tolerance, its first steps' error), so their runs
+# are not projected, only held to the manifold at the samples (`checked`)
+MULTISTEP = ("BDF", "LSODA")
+
+
+def checked(Y, t, method: str, rtol: float, project) -> np.ndarray:
+    """The samples Y of an unprojected run (a MULTISTEP method), each projected onto the
+    manifold (`project`, integrate_state) as an answer, where each correction is within the
+    tolerance; FloatingPointError at the first that is not: the run has left the manifold by
+    more than its tolerance allows."""
+    out = Y.copy()
+    for i in range(1, t.size):
+        out[i], ratio = project(Y[i], Y[i - 1])
+        if not ratio <= 1.0:
+            raise FloatingPointError(f"{method} leaves the constraints by {ratio:.3g} times what rtol {rtol:g} allows "
+                                     f"at t = {t[i]:.6g} s (a multistep method is not projected back onto them; "
+                                     "DOP853, RK45 and Radau are)")
+    return out
+
+
 SHORTEST = 2.0**-30  # of a sample interval: the shortest piece `projected` runs
 # the first piece, of the first sample interval: a whole interval first would be run in vain
 # where the drift over it is far over the tolerance (1000 s at once: 3500 times, the four-bar)
@@ -434,10 +455,10 @@ def projected(fun, t, y0, method: str, rtol: float, atol, kw: dict, project) -> 
     piece's end projected (`project`, integrate_state), every sample time the end of one.
     A piece whose correction is more than its tolerance allows (ratio > 1) is run again,
     shorter: the drift off a manifold grows with the piece's length, as its square for the
-    index-1 form of a model with constraints (docs/models.md), so the next length is the
-    last times 0.5/sqrt(ratio), within [1/100, 1/2] after a rejected piece and at most
-    twice after an accepted one (a piece cut short by its sample time only shortens it).
-    A piece of SHORTEST of its interval still corrected by more: FloatingPointError."""
+    index-1 form of a model with constraints (docs/models.md), so the length is the last
+    times 0.5/sqrt(ratio), within [1/100, 1/2]; after an accepted piece it doubles (ratio
+    <= 1/4), grows by 1/4 (<= 1/2) or stays. A piece of SHORTEST of its interval still
+    corrected by more: FloatingPointError."""
     from scipy.integrate import solve_ivp
 
     Y = np.empty((t.size, y0.size))
@@ -456,16 +477,19 @@ def projected(fun, t, y0, method: str, rtol: float, atol, kw: dict, project) -> 
             if not np.isfinite(ratio):
                 raise FloatingPointError(f"at t = {c:.6g} s the motion cannot be put back on its constraints "
                                          "(Newton's method meets no point of them from there)")
-            factor = 2.0 if ratio == 0 else 0.5 / math.sqrt(ratio)
             if ratio > 1.0:
                 if not c - a > (b - a) * SHORTEST:
                     raise FloatingPointError(
                         f"the motion leaves its constraints faster than the tolerance allows: from t = {a:.6g} s to "
                         f"{c:.6g} s the correction back onto them is {ratio:.3g} times what rtol {rtol:g} allows")
-                span = (c - a) * min(max(factor, 0.01), 0.5)
+                span = (c - a) * min(max(0.5 / math.sqrt(ratio), 0.01), 0.5)
                 continue
-            cut = c == b and c - a < span  # ended by its sample time
-            span = min(span, (c - a) * factor) if cut else (c - a) * min(factor, 2.0)
+            # accepted: never shorter; twice as long where the square of the drift allows it,
+            # a little longer where a floor of the correction (a restarted multistep method's
+            # first steps: BDF's about 0.25 at any length) says little of the drift
+            grow = 2.0 if ratio <= 0.25 else 1.25 if ratio <= 0.5 else 1.0
+            if not (c == b and c - a < span):  # a piece ended by its sample time leaves the span
+                span = (c - a) * grow
             y, a = y1, c
         Y[i] = y
     return Y
@@ -499,7 +523,8 @@ def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budg
     constraints and their rates, gyro.analyses.motion.Constraints), project(y, y_before) ->
     (the point on it, the correction's size in units of what the tolerance allows of each
     component, atol + rtol max(|y|, |y_before|)): the run then goes from one sample time to
-    the next (`projected`), each end projected."""
+    the next (`projected`), each end projected; a MULTISTEP method's samples are only held
+    to it (`checked`)."""
     import casadi as ca
 
     t = np.asarray(t, float)
@@ -518,7 +543,7 @@ def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budg
             fun = WATCH.wrap(fun, t[0], t[-1])
         try:
             with np.errstate(all="ignore"):
-                if project is not None:
+                if project is not None and method not in MULTISTEP:
                     return projected(fun, t, y0, method, rtol, atol, kw, project)
                 sol = solve_ivp(fun, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol, **kw)
         finally:
@@ -528,7 +553,7 @@ def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budg
             reached = np.asarray(sol.t, float)  # a list where the method failed at its first step
             raise FloatingPointError(f"{method} stopped at t = {reached[-1] if reached.size else t[0]:.6g} s: "
                                      f"{sol.message}")
-        return sol.y.T
+        return sol.y.T if project is None else checked(sol.y.T, t, method, rtol, project)
     if method in SUNDIALS:
         if project is not None:
             raise ValueError(f"{method}: a run projected onto constraints is SciPy's methods' only")

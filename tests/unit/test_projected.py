@@ -45,3 +45,15 @@ def test_a_projection_out_of_tolerance_is_no_answer(ratio, match):
     with pytest.raises(FloatingPointError, match=match):
         ode.projected(_fun, np.linspace(0.0, 1.0, 3), np.array([1.0, 0.0]), "DOP853", 1e-10, 1e-12, {},
                       lambda y, before: (y, ratio))
+
+
+def test_a_multistep_run_is_held_to_the_manifold_at_its_samples():
+    """BDF and LSODA are not restarted (a restart costs them their history): their samples are
+    projected where each correction is within the tolerance, else the run is no answer."""
+    t = np.linspace(0.0, 1.0, 3)
+    Y = np.column_stack([np.cos(t), -np.sin(t)]) * (1 + np.array([0.0, 1e-12, 1e-8]))[:, None]
+    project, _ = _onto_circle(1e-10, 1e-12)
+    with pytest.raises(FloatingPointError, match="leaves the constraints by .* at t = 1 s"):
+        ode.checked(Y, t, "BDF", 1e-10, project)
+    out = ode.checked(Y[:2], t[:2], "BDF", 1e-10, project)
+    assert np.max(np.abs(np.hypot(out[:, 0], out[:, 1]) - 1.0)) <= 2 * np.finfo(float).eps

@@ -152,7 +152,7 @@ def equilibria_reported(model: Model, P, tol=TOL, max_iter=MAX_ITER):
 DEPENDENT_STARTS = (1.0, 0.5, -1.0, 2.0, -0.5, 0.1)
 
 
-def on_constraints(model: Model, P, q0, is_angle, max_iter: int = 50):
+def on_constraints(model: Model, P, q0, is_angle, max_iter: int = 50, starts=(None, *DEPENDENT_STARTS)):
     """The starts of a model with multipliers moved onto its constraints: the independent
     coordinates as they are, the dependent ones solved from phi(q) = 0 by Newton's method on
     the emitted constraints and their Jacobian (quantity `constraints`), from the start as
@@ -160,14 +160,17 @@ def on_constraints(model: Model, P, q0, is_angle, max_iter: int = 50):
     from each of DEPENDENT_STARTS in turn (a start of zero puts a pendulum in Cartesian
     coordinates at its pivot, where the constraint's Jacobian vanishes). The first start whose iteration meets
     the constraints to 1e-12 of the coordinates' size answers a set; a set none does keeps
-    its start (the equilibrium's own Newton then tries, and its residual test decides)."""
+    its start (the equilibrium's own Newton then tries, and its residual test decides).
+    `starts` (None: the start as given) the dependent coordinates' starts tried: a motion's
+    start and its projections take (None,) alone, the branch they are on
+    (gyro.analyses.motion.Constraints)."""
     meta = model.meta
     names = list(meta["equilibrium_coordinates"])
     dep = [names.index(c) for c in meta["constraints"]["dependent"]]
     fn = function(model, "constraints")
     q0 = np.array(q0, float)
     todo = np.arange(P.shape[0])
-    for start in (None, *DEPENDENT_STARTS):  # None: the model's own start (equilibrium_approx) first
+    for start in starts:  # None: the model's own start (equilibrium_approx) first
         if todo.size == 0:
             break
         q = q0[todo].copy()

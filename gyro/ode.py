@@ -423,6 +423,78 @@ def two_tolerances(run, rtol: float, finer: float = 1e-2):
     return q2, 2 * np.max(np.abs(q1 - q2), axis=0)
 
 
+# SciPy's multistep methods: a restart costs them their history (BDF restarted every 1e-4 s
+# at rtol 1e-10 still corrects by 0.7 of the tolerance, its first steps' error), so their runs
+# are not projected, only held to the manifold at the samples (`checked`)
+MULTISTEP = ("BDF", "LSODA")
+
+
+def checked(Y, t, method: str, rtol: float, project) -> np.ndarray:
+    """The samples Y of an unprojected run (a MULTISTEP method), each projected onto the
+    manifold (`project`, integrate_state) as an answer, where each correction is within the
+    tolerance; FloatingPointError at the first that is not: the run has left the manifold by
+    more than its tolerance allows."""
+    out = Y.copy()
+    for i in range(1, t.size):
+        out[i], ratio = project(Y[i], Y[i - 1])
+        if not ratio <= 1.0:
+            raise FloatingPointError(f"{method} leaves the constraints by {ratio:.3g} times what rtol {rtol:g} allows "
+                                     f"at t = {t[i]:.6g} s (a multistep method is not projected back onto them; "
+                                     "DOP853, RK45 and Radau are)")
+    return out
+
+
+SHORTEST = 2.0**-30  # of a sample interval: the shortest piece `projected` runs
+# the first piece, of the first sample interval: a whole interval first would be run in vain
+# where the drift over it is far over the tolerance (1000 s at once: 3500 times, the four-bar)
+FIRST = 64
+
+
+def projected(fun, t, y0, method: str, rtol: float, atol, kw: dict, project) -> np.ndarray:
+    """States (len(t), size) of solve_ivp's `method` on fun from y0, run in pieces, each
+    piece's end projected (`project`, integrate_state), every sample time the end of one.
+    A piece whose correction is more than its tolerance allows (ratio > 1) is run again,
+    shorter: the drift off a manifold grows with the piece's length, as its square for the
+    index-1 form of a model with constraints (docs/models.md), so the length is the last
+    times 0.5/sqrt(ratio), within [1/100, 1/2]; after an accepted piece it doubles (ratio
+    <= 1/4), grows by 1/4 (<= 1/2) or stays. A piece of SHORTEST of its interval still
+    corrected by more: FloatingPointError."""
+    from scipy.integrate import solve_ivp
+
+    Y = np.empty((t.size, y0.size))
+    Y[0] = y = y0
+    if t.size < 2:
+        return Y
+    span = (t[1] - t[0]) / FIRST  # doubled while the corrections are small: a few pieces at most
+    for i in range(1, t.size):
+        a, b = t[i - 1], t[i]
+        while a < b:
+            c = b if b - a <= span else a + span
+            sol = solve_ivp(fun, (a, c), y, method=method, rtol=rtol, atol=atol, **kw)
+            if sol.status != 0:
+                raise FloatingPointError(f"{method} stopped at t = {sol.t[-1]:.6g} s: {sol.message}")
+            y1, ratio = project(sol.y[:, -1], y)
+            if not np.isfinite(ratio):
+                raise FloatingPointError(f"at t = {c:.6g} s the motion cannot be put back on its constraints "
+                                         "(Newton's method meets no point of them from there)")
+            if ratio > 1.0:
+                if not c - a > (b - a) * SHORTEST:
+                    raise FloatingPointError(
+                        f"the motion leaves its constraints faster than the tolerance allows: from t = {a:.6g} s to "
+                        f"{c:.6g} s the correction back onto them is {ratio:.3g} times what rtol {rtol:g} allows")
+                span = (c - a) * min(max(0.5 / math.sqrt(ratio), 0.01), 0.5)
+                continue
+            # accepted: never shorter; twice as long where the square of the drift allows it,
+            # a little longer where a floor of the correction (a restarted multistep method's
+            # first steps: BDF's about 0.25 at any length) says little of the drift
+            grow = 2.0 if ratio <= 0.25 else 1.25 if ratio <= 0.5 else 1.0
+            if not (c == b and c - a < span):  # a piece ended by its sample time leaves the span
+                span = (c - a) * grow
+            y, a = y1, c
+        Y[i] = y
+    return Y
+
+
 SCIPY_METHODS = ("DOP853", "RK45", "Radau", "BDF", "LSODA")  # DOP853 first: the default
 STIFF = ("Radau", "BDF", "LSODA")  # SciPy's methods that take the Jacobian
 # SUNDIALS through CasADi: the integrator and its options (cvodes-adams: non-stiff
@@ -432,8 +504,8 @@ SUNDIALS = {"cvodes": ("cvodes", {}), "idas": ("idas", {}),
 
 
 def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budget_s: float = math.inf,
-                    budget_steps: float = math.inf, jac: bool = False, inputs=None, label: str | None = None
-                    ) -> np.ndarray:
+                    budget_steps: float = math.inf, jac: bool = False, inputs=None, label: str | None = None,
+                    project=None) -> np.ndarray:
     """States (len(t), 2n) of y' = f(y, P) (the emitted equations of motion; the further
     inputs zero, or for SciPy's methods `inputs(t)` as numpy_rhs takes it) from y0 at t[0],
     at the times t: one integrator for every model's motions; `label` names the run in a
@@ -445,7 +517,14 @@ def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budg
     idas), budget_steps shared out over the output intervals (at least 500 each; SUNDIALS
     counts steps between outputs), its own lines on stderr silenced: IntegrationBudget where
     it gives up (its budget, or a failed step). The budgets are the command line's; a library
-    call without them runs to the end."""
+    call without them runs to the end.
+
+    `project` (SciPy's methods): a map onto a manifold the motion keeps (a model's holonomic
+    constraints and their rates, gyro.analyses.motion.Constraints), project(y, y_before) ->
+    (the point on it, the correction's size in units of what the tolerance allows of each
+    component, atol + rtol max(|y|, |y_before|)): the run then goes from one sample time to
+    the next (`projected`), each end projected; a MULTISTEP method's samples are only held
+    to it (`checked`)."""
     import casadi as ca
 
     t = np.asarray(t, float)
@@ -464,6 +543,8 @@ def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budg
             fun = WATCH.wrap(fun, t[0], t[-1])
         try:
             with np.errstate(all="ignore"):
+                if project is not None and method not in MULTISTEP:
+                    return projected(fun, t, y0, method, rtol, atol, kw, project)
                 sol = solve_ivp(fun, (t[0], t[-1]), y0, method=method, t_eval=t, rtol=rtol, atol=atol, **kw)
         finally:
             if hasattr(fun, "done"):
@@ -472,8 +553,10 @@ def integrate_state(model: Model, P, y0, t, method: str, rtol: float, atol, budg
             reached = np.asarray(sol.t, float)  # a list where the method failed at its first step
             raise FloatingPointError(f"{method} stopped at t = {reached[-1] if reached.size else t[0]:.6g} s: "
                                      f"{sol.message}")
-        return sol.y.T
+        return sol.y.T if project is None else checked(sol.y.T, t, method, rtol, project)
     if method in SUNDIALS:
+        if project is not None:
+            raise ValueError(f"{method}: a run projected onto constraints is SciPy's methods' only")
         if inputs is not None:
             raise ValueError(f"{method}: the equations' time-varying inputs are SciPy's methods' only")
         name, extra = SUNDIALS[method]

@@ -29,11 +29,132 @@ IntegrationBudget = ode.IntegrationBudget  # the one type (gyro/ode.py)
 
 @dataclass
 class Start:
-    """Where a motion starts: the reference state, the offsets, and the state itself."""
+    """Where a motion starts: the reference state, the offsets, and the state itself; for a
+    model with multipliers its `constraints` (Constraints), and the coordinates and rates
+    `solved` from them."""
     q_ref: np.ndarray
     qd_ref: np.ndarray
     y0: np.ndarray
     equilibrium: dict
+    constraints: "Constraints | None" = None
+    solved: tuple = ()
+
+
+def carried(model) -> dict | None:
+    """The metadata 'constraints' of a model whose holonomic constraints are carried by
+    multipliers, else None."""
+    c = model.meta.get("constraints") or {}
+    return c if c.get("multipliers") else None
+
+
+class Constraints:
+    """The holonomic constraints of a model with multipliers about one reference q_ref, from
+    the emitted quantity `constraints` (phi(q) and Phi_q = dphi/dq) and the metadata's
+    `dependent` coordinates: `position(q)` keeps q's independent coordinates and solves the
+    dependent ones from phi(q) = 0 by Newton's method from their values in q
+    (gyro.equilibrium.on_constraints, that start alone), on the reference's branch (the
+    sign of det dphi/dq_dep as at q_ref: another branch lies past a point where it
+    vanishes); `rates(q, qd)` solves the dependent rates from Phi_q q' = 0; `project(y,
+    y_before)` puts a state of the motion back onto phi = 0 and Phi_q q' = 0 (the nearest
+    point, `nearest`) and measures the corrections against the integrator's tolerance
+    (ode.integrate_state's `project`), the largest accepted one kept per coordinate and rate
+    (`drift`)."""
+
+    def __init__(self, model, P, q_ref, rtol: float = 0.0, atol=0.0):
+        meta = model.meta
+        c = carried(model)
+        self.model, self.P = model, np.asarray(P, float)
+        self.coords = list(meta["coordinates"])
+        if list(meta["equilibrium_coordinates"]) != self.coords:  # on_constraints' layout
+            raise ParameterError(f"{model.name}: its multipliers come with coordinates that have no equilibrium "
+                                 f"({', '.join(c for c in self.coords if c not in meta['equilibrium_coordinates'])})"
+                                 ": its constraints are not solved for a motion")
+        self.dependent, self.independent = list(c["dependent"]), list(c["independent"])
+        self.dep = np.array([self.coords.index(x) for x in self.dependent], int)
+        self.ind = np.array([self.coords.index(x) for x in self.independent], int)
+        self.nq = len(self.coords)
+        units = meta.get("coordinate_units", {})
+        self.is_angle = np.array([units.get(x) == "rad" for x in self.coords], bool)
+        self.rtol, self.atol = rtol, atol
+        self.branch = self._sign(np.asarray(q_ref, float))
+        self.drift = np.zeros(2 * self.nq)  # the largest accepted corrections, q then q'
+
+    def tolerance(self, rtol: float, atol) -> "Constraints":
+        """These constraints projecting against another tolerance, their drift from zero."""
+        import copy
+
+        out = copy.copy(self)
+        out.rtol, out.atol, out.drift = rtol, atol, np.zeros_like(self.drift)
+        return out
+
+    def _evaluate(self, q):
+        with np.errstate(all="ignore"):
+            phi, J = function(self.model, "constraints")(self.P[None], np.asarray(q, float)[None])
+        return np.asarray(phi, float).reshape(-1), np.asarray(J, float).reshape(len(self.dep), self.nq)
+
+    def _sign(self, q) -> float:
+        J = self._evaluate(q)[1]
+        return float(np.sign(np.linalg.det(J[:, self.dep]))) if np.all(np.isfinite(J)) else 0.0
+
+    def position(self, q) -> np.ndarray | None:
+        """q with its dependent coordinates solved from phi = 0 on the reference's branch, or
+        None where Newton's method from them meets no point of it."""
+        from gyro.equilibrium import on_constraints
+
+        out = on_constraints(self.model, self.P[None], np.asarray(q, float)[None], self.is_angle,
+                             starts=(None,))[0]
+        phi = self._evaluate(out)[0]
+        met = np.all(np.isfinite(out)) and np.max(np.abs(phi)) <= 1e-12 * max(1.0, float(np.max(np.abs(out))))
+        return out if met and self.branch != 0 and self._sign(out) == self.branch else None
+
+    def rates(self, q, qd) -> np.ndarray:
+        """qd with its dependent rates from Phi_q q' = 0 at q (its independent rates as given)."""
+        J = self._evaluate(q)[1]
+        out = np.array(qd, float)
+        out[self.dep] = np.linalg.solve(J[:, self.dep], -J[:, self.ind] @ out[self.ind]) + 0.0  # no -0
+        return out
+
+    def nearest(self, q) -> np.ndarray | None:
+        """The point of the constraints nearest q (Newton's method with the least-norm step,
+        dq = Phi_q' (Phi_q Phi_q')^-1 phi, over all coordinates: it needs no partition, so it
+        holds where the dependent block is singular, a bead at its hoop's equator), or None
+        where it meets none (phi within 1e-12 of the coordinates' size, as `position`)."""
+        q = np.array(q, float)
+        for _ in range(20):
+            phi, J = self._evaluate(q)
+            with np.errstate(all="ignore"):
+                try:
+                    step = J.T @ np.linalg.solve(J @ J.T, phi)
+                except np.linalg.LinAlgError:
+                    return None
+            if not np.all(np.isfinite(step)):
+                return None
+            q -= step
+            if np.max(np.abs(step), initial=0.0) <= 4 * np.finfo(float).eps * max(1.0, float(np.max(np.abs(q)))):
+                break
+        phi = self._evaluate(q)[0]
+        return q if np.max(np.abs(phi)) <= 1e-12 * max(1.0, float(np.max(np.abs(q)))) else None
+
+    def project(self, y, before):
+        """(y on the constraints, the largest correction over what the tolerance allows of its
+        component, atol + rtol max(|y|, |before|)); inf where `nearest` finds no point. The
+        coordinates to the nearest point of phi = 0, the rates to the nearest of Phi_q q' = 0
+        there (q' - Phi_q' (Phi_q Phi_q')^-1 Phi_q q'): the standard orthogonal projection,
+        which follows the motion onto any branch it swings to (a bead over its hoop's top)."""
+        n = self.nq
+        q = self.nearest(y[:n])
+        if q is None:
+            return y, np.inf
+        J = self._evaluate(q)[1]
+        qd = y[n:] - J.T @ np.linalg.solve(J @ J.T, J @ y[n:])
+        out = np.concatenate([q, qd])
+        change = np.abs(out - y)
+        allowed = np.broadcast_to(self.atol, y.shape) + self.rtol * np.maximum(np.abs(y), np.abs(before))
+        with np.errstate(all="ignore"):
+            ratio = float(np.max(np.where(change == 0, 0.0, change / allowed), initial=0.0))
+        if ratio <= 1.0:
+            self.drift = np.maximum(self.drift, change)
+        return out, ratio
 
 
 def perturbations(model, items: dict) -> dict:
@@ -43,11 +164,18 @@ def perturbations(model, items: dict) -> dict:
 
     coords = list(model.meta["coordinates"])
     known = coords + [f"{c}_d" for c in coords]
+    c = carried(model)
+    dependent = c["dependent"] if c else []
     out = {}
     for name, raw in items.items():
         if name not in known:
             raise ParameterError(f"--perturb {name}: not a coordinate of {model.name} nor a rate NAME_d; "
                                  f"known: {' '.join(known)}")
+        if name.removesuffix("_d") in dependent:
+            free = c["independent"] + [f"{x}_d" for x in c["independent"]]
+            raise ParameterError(f"--perturb {name}: {name.removesuffix('_d')} is a dependent coordinate of "
+                                 f"{model.name}, solved from its constraints at the start; offset the independent "
+                                 f"ones: {' '.join(free)}")
         out[name] = finite_number(f"--perturb {name}", raw)
     return out
 
@@ -89,7 +217,18 @@ def start(model, P, offsets: dict, qe: np.ndarray | None = None) -> Start:
             q0[coords.index(name)] += value
         else:
             qd0[coords.index(name[:-2])] += value
-    return Start(q_ref, qd_ref, np.concatenate([q0, qd0]), dict(zip(eq_names, map(float, qe[0]))))
+    equilibrium = dict(zip(eq_names, map(float, qe[0])))
+    if not carried(model):
+        return Start(q_ref, qd_ref, np.concatenate([q0, qd0]), equilibrium)
+    cons = Constraints(model, P[0], q_ref, RTOL, ATOL)
+    q1 = cons.position(q0)
+    if q1 is None:
+        given = [k for k in offsets if k in coords]
+        raise ParameterError(f"--perturb {' '.join(given)}: no point of {model.name}'s constraints near its "
+                             f"reference has {' and '.join(f'{k} = {q0[coords.index(k)]:g}' for k in given)} "
+                             f"({', '.join(cons.dependent)} solved from them on the reference's branch)")
+    solved = tuple(cons.dependent) + tuple(f"{x}_d" for x in cons.dependent)
+    return Start(q_ref, qd_ref, np.concatenate([q1, cons.rates(q1, qd0)]), equilibrium, cons, solved)
 
 
 # the linear motion's fine grid, its samples times the states at the most (some 80 MB an
@@ -147,41 +286,64 @@ def simulate(model, values: dict, offsets: dict, t: np.ndarray, method: str = "D
                              f"integration would need about {need:.2g} evaluations of the equations, over its budget of "
                              f"{BUDGET_EVALUATIONS:.0e}: a shorter horizon")
     t0 = time.perf_counter()
+    cons = st.constraints
     Y = ode.integrate_state(model, P, st.y0, t, method, RTOL, ATOL, budget_s, BUDGET_EVALUATIONS,
-                            inputs=_inputs(model), label=f"{method} on {model.name}")
+                            inputs=_inputs(model), label=f"{method} on {model.name}",
+                            project=cons.project if cons else None)
     if not np.all(np.isfinite(Y)):
         raise FloatingPointError("a coordinate is not finite along the motion")
     n = len(model.meta["coordinates"])
+    extra = {}
+    if cons:
+        names = [*cons.coords, *(f"{x}_d" for x in cons.coords)]
+        extra = {"start": dict(zip(names, map(float, st.y0))), "solved": list(st.solved),
+                 "constraint_residual": dict(zip(names, map(float, cons.drift)))}
     return coordinate_motion(model, method, t, Y[:, :n], Y[:, n:], dict(values), dict(offsets), st.equilibrium,
-                             time.perf_counter() - t0)
+                             time.perf_counter() - t0, extra)
 
 
 # the generic motion's document: these keys, then each coordinate not among them
 HEAD = ["model", "method", "params", "perturb", "equilibrium", "coordinates", "units", "t", "rates", "seconds"]
 
 
+# and, for a model with multipliers, these after them
+CONSTRAINED = ["start", "solved", "constraint_residual"]
+
+
 def coordinate_motion(model, method: str, t, q, qd, params: dict, perturb: dict, equilibrium: dict,
-                      seconds: float = 0.0):
+                      seconds: float = 0.0, constrained: dict | None = None):
     """A motion of any model in its coordinates, as gyro.results.Motion: q and qd (times,
     coordinates) absolute values in the model's units, the series the coordinates and their
     rates NAME_d; the `gyro simulate --json` document of the generic motion: `t`, one list
     per coordinate under its name, `method`, and `rates` ({NAME_d: list}), `coordinates`,
     `units`, `params`, `perturb`, `equilibrium`, `model`, `seconds` (a model file's motion
-    of its own may give its own in the same form: tests/models/oscillator_own_motion.py)."""
+    of its own may give its own in the same form: tests/models/oscillator_own_motion.py).
+    A model with multipliers adds `constrained` (CONSTRAINED): `start`, the state at t = 0
+    ({NAME: value, NAME_d: value}), `solved`, which of them were solved from the
+    constraints, and `constraint_residual` ({NAME: largest, NAME_d: largest} over the
+    coordinates and rates: the largest correction that put the integrated state back onto
+    the constraints, each within the integrator's tolerance; the states given are on them
+    to Newton's rounding); the text's second line says so."""
     from gyro.results import Motion
 
     coords = list(model.meta["coordinates"])
     units = [model.meta.get("coordinate_units", {}).get(c, "") for c in coords]
     rates = [f"{c}_d" for c in coords]
     title = model.meta.get("title", model.name)
-    heading = (f"{title} ({model.name}), method {method}, from the reference"
-               + (" with " + ", ".join(f"{k} {v:+g}" for k, v in perturb.items()) if perturb else ""))
+    heading = [f"{title} ({model.name}), method {method}, from the reference"
+               + (" with " + ", ".join(f"{k} {v:+g}" for k, v in perturb.items()) if perturb else "")]
     info = {"params": params, "perturb": perturb, "equilibrium": equilibrium, "coordinates": coords,
-            "units": dict(zip(coords, units)), "seconds": seconds}
+            "units": dict(zip(coords, units)), "seconds": seconds, **(constrained or {})}
+    if constrained:
+        start = constrained["start"]
+        heading.append("on the constraints: " + ", ".join(f"{k} = {start[k]:.9g}" for k in constrained["solved"])
+                       + " solved at the start; put back onto them along the motion, each correction within "
+                       "the tolerance (the largest: constraint_residual)")
+    head = HEAD + (CONSTRAINED if constrained else [])
     return Motion(model.name, title, method, np.asarray(t), coords + rates, np.hstack([q, qd]),
                   units + [f"{u}/s" if u else "1/s" for u in units],
                   [f"the coordinate {c}" for c in coords] + [f"the rate of {c}" for c in coords], info=info,
-                  keys=HEAD + [c for c in coords if c not in HEAD], groups={"rates": rates}, heading=[heading],
+                  keys=head + [c for c in coords if c not in head], groups={"rates": rates}, heading=heading,
                   shown=coords, formats={"t": ">12.6g", **{c: ">16.9g" for c in coords}}, gap="")
 
 
@@ -194,16 +356,15 @@ class ReducedState:
     and rate offsets xd: q = q_ref + x and q' = qd_ref + xd on the reduced coordinates (a
     steady coordinate keeps its declared rate plus xd), the cyclic coordinates' rates from
     their momenta (the emitted `cyclic_rates`: for the torsion gyrocompass gamma3' from the
-    integral C r2 = H, (2.3))."""
+    integral C r2 = H, (2.3)). A model with multipliers: the reduced coordinates are the
+    independent ones, the dependent coordinates and rates solved from the constraints on the
+    reference's branch (`constraints`, Constraints; with lib = casadi by CasADi's Newton
+    rootfinder, the rates by the linear solve: an implicit map, exact to its tolerance)."""
 
     def __init__(self, model, values: dict):
         from gyro.equilibrium import equilibrium
 
         meta = model.meta
-        if meta.get("constraints", {}).get("multipliers"):
-            raise ParameterError(f"{model.name}: its constraints are carried by multipliers: the reduced motion "
-                                 "(offsets of the independent coordinates alone) would leave them; not built for "
-                                 "such a model (gyro simulate integrates its full equations)")
         if any(i["name"] == "time" for i in meta["functions"]["forcing"]["inputs"]):
             raise ParameterError(f"{model.name}: its equations hold the time explicitly: no reduced motion about "
                                  "a reference (the linear motion needs autonomous equations)")
@@ -217,12 +378,18 @@ class ReducedState:
         self.nq, self.n = len(self.coords), len(self.ri)
         st = start(model, self.P, {}, self.qe)
         self.q_ref, self.qd_ref = st.q_ref, st.qd_ref
+        self.constraints = st.constraints
+        if self.constraints is not None and list(self.constraints.ind) != list(self.ri):
+            raise ParameterError(f"{model.name}: its reduced coordinates ({', '.join(meta['reduced'])}) are not its "
+                                 f"independent ones ({', '.join(self.constraints.independent)})")
         if self.ci and "cyclic_rates" not in meta["functions"]:
             raise ParameterError(f"{model.name}: emitted without cyclic_rates (derive it again with this version)")
 
     def state(self, x, xd, lib=np):
         """The full state (q, q') of reduced displacements x and rate offsets xd; with
-        lib = casadi, of symbols (an SX column)."""
+        lib = casadi, of symbols (an SX column; MX for a model with multipliers)."""
+        if self.constraints is not None:
+            return self._constrained_state(x, xd, lib)
         if lib is np:
             q, qd = self.q_ref.copy(), self.qd_ref.copy()
             q[self.ri] += x
@@ -240,6 +407,66 @@ class ReducedState:
             for j, i in enumerate(self.ci):
                 qd[i] = rates[j]
         return lib.vertcat(*q, *qd)
+
+    def _constrained_state(self, x, xd, lib):
+        """state() of a model with multipliers: the independent coordinates and rates offset,
+        the dependent ones solved (Constraints; with lib = casadi the rootfinder, `_dependent`)."""
+        cons = self.constraints
+        if lib is np:
+            q, qd = self.q_ref.copy(), self.qd_ref.copy()
+            q[self.ri] += x
+            qd[self.ri] += xd
+            q1 = cons.position(q)
+            if q1 is None:
+                raise ParameterError(f"--set {' '.join(f'{self.coords[i]}_0' for i in self.ri)}: no point of "
+                                     f"{self.model.name}'s constraints near its reference has "
+                                     + " and ".join(f"{self.coords[i]} = {q[i]:g}" for i in self.ri)
+                                     + f" ({', '.join(cons.dependent)} solved from them on the reference's branch)")
+            return np.concatenate([q1, cons.rates(q1, qd)])
+        ind = lib.vertcat(*[float(self.q_ref[i]) + x[j] for j, i in enumerate(self.ri)])
+        rates = lib.vertcat(*[float(self.qd_ref[i]) + xd[j] for j, i in enumerate(self.ri)])
+        dep = self._dependent(lib.DM(self.q_ref[cons.dep]), ind)
+        q = [None] * self.nq
+        for j, i in enumerate(self.ri):
+            q[i] = ind[j]
+        for j, i in enumerate(cons.dep):
+            q[i] = dep[j]
+        q = lib.vertcat(*q)
+        J = self.model.casadi.constraints(lib.DM(self.P), q)[1]
+        dep_rates = -lib.solve(J[:, list(cons.dep)], J[:, list(self.ri)] @ rates)
+        qd = [None] * self.nq
+        for j, i in enumerate(self.ri):
+            qd[i] = rates[j]
+        for j, i in enumerate(cons.dep):
+            qd[i] = dep_rates[j]
+        return lib.vertcat(q, *qd)
+
+    @cached_property
+    def _dependent(self):
+        """CasADi's Newton rootfinder (guess, independent coordinates) -> the dependent
+        coordinates on phi = 0, from the reference's values: the offsets a reduced motion
+        takes are small (CAP), so the reference's branch. Its residual tolerance 1e-14 of
+        the constraints' terms at the reference (|Phi_q| |q|; phi's rounding is some 1e-16 of
+        them), its step tolerance 1e-15 of the coordinates' size; a Newton that
+        does not converge raises (error_on_fail), never an unconverged point."""
+        import casadi as ca
+
+        cons = self.constraints
+        guess = ca.SX.sym("dependent", len(cons.dep))
+        ind = ca.SX.sym("independent", self.n)
+        q = [None] * self.nq
+        for j, i in enumerate(self.ri):
+            q[i] = ind[j]
+        for j, i in enumerate(cons.dep):
+            q[i] = guess[j]
+        phi = self.model.casadi.constraints(ca.DM(self.P), ca.vertcat(*q))[0]
+        J = cons._evaluate(self.q_ref)[1]
+        terms = float(np.max(np.abs(J) @ np.abs(self.q_ref)))
+        terms = terms if terms > 0 else 1.0
+        size = max(1.0, float(np.max(np.abs(self.q_ref))))
+        G = ca.Function("constraints_dependent", [guess, ind], [phi])
+        return ca.rootfinder("dependent", "newton", G, {"error_on_fail": True, "abstol": 1e-14 * terms,
+                                                        "abstolStep": 1e-15 * size, "max_iter": 50})
 
     def state_jacobian(self, Y: np.ndarray) -> np.ndarray:
         """d state / d (x, xd) at full states Y (2 nq, N): (N, 2 nq, 2 n): the identity on the
@@ -281,10 +508,15 @@ class ReducedState:
         import casadi as ca
 
         sym = ode.symbolic(self.model)
-        z = ca.SX.sym("z", 2 * self.n)
-        Y = self.state(ca.vertsplit(z[:self.n]), ca.vertsplit(z[self.n:]), ca)
-        ydot = ca.substitute([sym.ydot], [sym.y, sym.p, *sym.inputs],
-                             [Y, ca.DM(self.P), *[ca.DM.zeros(v.numel()) for v in sym.inputs]])[0]
+        zeros = [ca.DM.zeros(v.numel()) for v in sym.inputs]
+        if self.constraints is not None:  # the state through a rootfinder: MX, the equations as a call
+            z = ca.MX.sym("z", 2 * self.n)
+            Y = self.state(ca.vertsplit(z[:self.n]), ca.vertsplit(z[self.n:]), ca)
+            ydot = ode.rhs(self.model)(Y, ca.DM(self.P), *zeros)
+        else:
+            z = ca.SX.sym("z", 2 * self.n)
+            Y = self.state(ca.vertsplit(z[:self.n]), ca.vertsplit(z[self.n:]), ca)
+            ydot = ca.substitute([sym.ydot], [sym.y, sym.p, *sym.inputs], [Y, ca.DM(self.P), *zeros])[0]
         return ca.Function("reduced_rhs", [z], [ca.vertcat(z[self.n:], ydot[self.nq + self.ri])])
 
 
@@ -395,7 +627,7 @@ def _remainder(red: ReducedState, z: np.ndarray, f, what: str) -> np.ndarray:
     39000 samples)."""
     watch = ode.WATCH
     if watch is None or z.shape[0] <= CHUNK:
-        return np.asarray(f(z.T)).T
+        return _evaluated(red, f, z)
     tick, finished = watch.meter(what)
     out = np.empty_like(z)
     each = red.rhs.map(CHUNK)
@@ -403,11 +635,28 @@ def _remainder(red: ReducedState, z: np.ndarray, f, what: str) -> np.ndarray:
         for s in range(0, z.shape[0], CHUNK):
             block = z[s:s + CHUNK]
             g = each if block.shape[0] == CHUNK else red.rhs.map(block.shape[0])
-            out[s:s + CHUNK] = np.asarray(g(block.T)).T
+            out[s:s + CHUNK] = _evaluated(red, g, block)
             tick((s + block.shape[0]) / z.shape[0])
     finally:
         finished()
     return out
+
+
+def _evaluated(red: ReducedState, f, z: np.ndarray) -> np.ndarray:
+    """f (a map of red.rhs) over the samples z (rows). For a model with multipliers its
+    rootfinder may meet no point of the constraints (a linear motion that swings past their
+    reach): one line saying where, CasADi's dump of the inputs kept off stderr."""
+    if red.constraints is None:
+        return np.asarray(f(z.T)).T
+    try:
+        with ode.stderr_silenced():
+            return np.asarray(f(z.T)).T
+    except RuntimeError:
+        x = z[np.argmax(np.max(np.abs(z[:, :red.n]), axis=1)), :red.n]
+        at = ", ".join(f"{red.coords[i]} = {red.q_ref[i] + v:.6g}" for i, v in zip(red.ri, x))
+        raise FloatingPointError(f"the linear motion reaches {at}, where Newton's method finds no point of the "
+                                 f"constraints for {', '.join(red.constraints.dependent)} on the reference's "
+                                 "branch") from None
 
 
 def integrate_reduced(red: ReducedState, z0: np.ndarray, t, method: str = "DOP853", rtol: float = 1e-9,
@@ -417,7 +666,9 @@ def integrate_reduced(red: ReducedState, z0: np.ndarray, t, method: str = "DOP85
     sets the absolute tolerances, 1e-3 rtol of it (default: the linear motion's largest |x|,
     |x'|), so a small perturbation is resolved, but not below `floor` eps of the reference's
     largest coordinate (and that times the fastest frequency for the rates): there the
-    state's rounding, amplified by stiff springs, would stall the steps."""
+    state's rounding, amplified by stiff springs, would stall the steps. A model with
+    multipliers: projected onto its constraints (Constraints.project) at each sample time
+    and wherever its drift comes near the tolerance (ode.projected)."""
 
     t = np.asarray(t, float)
     n = red.n
@@ -430,7 +681,9 @@ def integrate_reduced(red: ReducedState, z0: np.ndarray, t, method: str = "DOP85
     atol = np.empty(2 * red.nq)
     atol[:red.nq] = max(1e-3 * rtol * scale[0], lo, np.finfo(float).tiny)
     atol[red.nq:] = max(1e-3 * rtol * scale[1], lo * w_max, np.finfo(float).tiny)
-    Y = ode.integrate_state(red.model, red.P, red.state(z0[:n], z0[n:]), t, method, rtol, atol)
+    cons = red.constraints
+    project = cons.tolerance(rtol, atol).project if cons is not None else None
+    Y = ode.integrate_state(red.model, red.P, red.state(z0[:n], z0[n:]), t, method, rtol, atol, project=project)
     return Y[:, red.ri]
 
 
@@ -564,10 +817,17 @@ def motion_answer(red: ReducedState, z0: np.ndarray, t, units: list, method: str
     twice the finer run's tolerance on the coordinates' size (an error the two runs share
     where both sit at the absolute tolerance's floor)."""
     t = np.asarray(t, float)
+    if red.constraints is not None:  # a start the constraints cannot meet: bad input, before any work
+        red.state(z0[:red.n], z0[red.n:])
     if method == "linear":
         return linear_answer(red, z0, t, units, cap_of=cap_of)
     n = red.n
-    zL = linear_motion(red, z0, t, CORRECTIONS, FINE)[0]
+    try:
+        zL = linear_motion(red, z0, t, CORRECTIONS, FINE)[0]
+    except FloatingPointError:  # its correction past the constraints' reach (_evaluated): the scale needs none
+        if red.constraints is None:
+            raise
+        zL = linear_motion(red, z0, t, corrections=0)[0]
     scale = np.array([np.max(np.abs(zL[:, :n])), np.max(np.abs(zL[:, n:]))])
     q, est = ode.two_tolerances(lambda r: integrate_reduced(red, z0, t, method, r, scale, FLOOR), rtol, FINER)
     return q, np.maximum(est, integration_floor(group_max(np.max(np.abs(q), axis=0), units), rtol))

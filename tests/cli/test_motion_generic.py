@@ -172,28 +172,6 @@ def test_a_model_file_declares_a_motion_hierarchy_on_the_generic_levels():
     assert rc == 2 and "psi_0" in err and len(error_lines(err)) == 1
 
 
-def test_the_generic_motion_refuses_a_model_with_multipliers(tmp_path):
-    """The reduced motion offsets the independent coordinates alone, which would leave a
-    multiplier's constraint: a generic motion level declared on tests/models/hoop_bead.py (a
-    bead held on a hoop by a multiplier) fails with that reason, which the one line of the
-    refusal names, never a motion off the hoop."""
-    src = tmp_path / "hoop_levels.py"
-    src.write_text("from derive.model import Bound, Level\n"
-                   "from tests.models import hoop_bead\n\n\n"
-                   "def build():\n"
-                   "    m = hoop_bead.build()\n"
-                   "    m.name, m.module = 'hoop_levels', __name__\n"
-                   "    m.levels = [Level('linear', 'second order', {'kind': 'trajectory', 'module': "
-                   "'gyro.analyses.motion', 'method': 'linear', 'quantities': ['x']}, "
-                   "{'motion': Bound(estimate=True)}, cost=1e-3)]\n"
-                   "    return m\n")
-    rc, out, err = run_cli("scene", str(src), "motion", "--tol", "0.5", "--set", "x_0=0.01")
-    assert rc == 1 and out == ""
-    (line,) = error_lines(err)
-    assert "no level gives a finite bound here (linear: hoop_levels: its constraints are carried by multipliers" \
-        in line
-
-
 def test_a_declared_file_module_is_found_beside_the_file_loaded_not_where_it_was_derived(tmp_path):
     """The derivation records a model file's own module relative to its folder
     (derive.model.runtime_module), and the runtime finds it beside the file it loads the

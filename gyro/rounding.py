@@ -1,0 +1,428 @@
+"""Running error bounds of CasADi functions: an enclosure of a double evaluation's rounding.
+
+`enclosure(F)` walks the algorithm of a CasADi SX Function (its instructions, in the order
+CasADi evaluates them) and builds a Function that returns, besides each output of F as
+evaluated in double precision op by op, an entrywise bound of |computed - exact|, where
+"exact" is F's value in exact arithmetic at inputs anywhere within given radii of the double
+inputs (radius 0: at the doubles themselves). Each operation carries its computed value v
+and a bound e of its distance from the exact value, from its operands' (a, e_a), (b, e_b):
+
+- + and -: e_a + e_b + u |v|   (the standard model in the form |fl(x) - x| <= u |fl(x)|,
+  Higham (2.5), u = 2^-53, round to nearest);
+- *: |a| e_b + |b| e_a + e_a e_b + u |v| + 2^-1074 (the last: underflow's absolute error);
+- /: (e_a + |v| e_b) / (|b| - e_b) + u |v| + 2^-1074, and +inf where |b| <= e_b;
+  1/a, a^2, 2a, -a, |a| likewise (2a, -a, |a| exact);
+- sqrt: e_a / sqrt(a) (|sqrt a - sqrt x| = |a - x| / (sqrt a + sqrt x)) + u |v|, +inf where
+  a <= e_a (the exact operand may be negative);
+- the elementary functions: the derivative's largest magnitude over [a - e_a, a + e_a],
+  bounded in closed form (sin: e_a (|cos a| + e_a + libm); cos alike; tan: e_a / (|cos a| -
+  e_a - libm)^2; exp: e_a |v| (1 + e_a + e_a^2) for e_a <= 1; log: e_a / (a - e_a); atan,
+  tanh: e_a; asin, acos: e_a / sqrt((1 - t)(1 + t)), t = |a| + e_a; sinh, cosh: e_a
+  cosh(|a| + e_a); atan2: the distance moved over the smallest radius, +inf where the box
+  meets the branch cut or the origin; a constant power by its derivative at the box's
+  ends), plus libm's own error, taken as LIBM_ULPS = 4 ulps of the result (an ulp of v is at
+  most 2u |v|): glibc does not round these correctly, its manual ("Known Maximum Errors in
+  Math Functions") gives its goal as "within a few ulp" and lists its measured maxima per
+  function and machine (1 ulp for double sin, cos, exp, log on x86_64); 4 keeps a margin
+  over every figure listed for them, and it is an assumption on the machine's libm, the one
+  part of this bound that is not derived here;
+- comparisons, sign, floor, ceil, if_else_zero: exact where the operands are exact (or, for
+  a comparison, apart by more than their bounds); +inf otherwise;
+- any other operation (and pow with an uncertain exponent): +inf, never a finite guess.
+
+The bound itself is evaluated in double precision: every formula above combines
+non-negative quantities by at most a dozen roundings, each of which can make it smaller by
+at most a factor 1 + u, so each is multiplied by GROW = 1 + 32 u (and 4 * 2^-1074 added for
+the underflow of its own products) and stays an upper bound. A value or a bound that is not
+finite gives a bound of +inf (NaN included: `Enclosure` turns it so after the call).
+
+Constants of the graph: a double that is a short dyadic number (an integer or a fraction
+with a power of two below 2^20 as its denominator, as 0.5, 1.5, -2, 4 are) is the model's
+constant exactly; any other (pi/180 as 0.017453292519943295) is taken within 2u of it (one
+rounding of the literal, or two where CasADi folded a product of constants).
+
+`Enclosure` compiles such a Function (CasADi's code generator -> gyro.cbackend, as
+gyro.ode.compiled does; ISO C99 keeps -ffp-contract=off, so the compiled code performs the
+operations the bound was derived for) with a loop over a batch, and falls back on CasADi's
+own evaluation without a compiler. `operator_rounding` is what the runtime uses: the
+operator's rounding, the equilibrium's and the difference to the operator actually used.
+"""
+from __future__ import annotations
+
+import math
+import os
+import re
+import threading
+
+import numpy as np
+
+U = 2.0**-53  # the unit roundoff of double precision, round to nearest
+TINY = 2.0**-1074  # the smallest subnormal: underflow's absolute error is at most half of it
+LIBM_ULPS = 4  # libm's error in sin, cos, tan, exp, log, atan, ..., taken in ulps (above)
+LIBM = 2 * LIBM_ULPS * U  # that relative to the result: an ulp of v is at most 2u |v|
+GROW = 1 + 32 * U  # each bound's own evaluation inflated by this: it stays an upper bound
+
+
+def _short_dyadic(c: float) -> bool:
+    """A constant that a model's exact expression holds as it is (integers, halves,
+    quarters, ...: a power of two below 2^20 as its denominator)."""
+    if not math.isfinite(c):
+        return False
+    s = c * 2.0**20
+    return s == math.floor(s) and abs(s) < 2.0**53
+
+
+def enclosure(F, uncertain=None, name: str | None = None):
+    """The Function (inputs of F, then a radius for each input named in `uncertain` (all
+    inputs where None), laid out as that input) -> (each output of F densified, then a
+    bound of each output's rounding, densified): the module's docstring says how. An input
+    not in `uncertain` is exact as given."""
+    import casadi as ca
+
+    names = [F.name_in(i) for i in range(F.n_in())]
+    uncertain = names if uncertain is None else list(uncertain)
+    for nm in uncertain:
+        if nm not in names:
+            raise ValueError(f"enclosure: {F.name()} has no input {nm!r}")
+    xs = [ca.SX.sym(nm, F.sparsity_in(i)) for i, nm in enumerate(names)]
+    rs = {nm: ca.SX.sym("r_" + nm, F.sparsity_in(names.index(nm))) for nm in uncertain}
+    x_nz = [[x.nz[j] for j in range(x.nnz())] for x in xs]
+    r_nz = {nm: [r.nz[j] for j in range(r.nnz())] for nm, r in rs.items()}
+    out_v = [[None] * F.nnz_out(i) for i in range(F.n_out())]
+    out_e = [[None] * F.nnz_out(i) for i in range(F.n_out())]
+    zero, inf = ca.SX(0.0), ca.SX(np.inf)
+    fabs = ca.fabs
+
+    def up(x):  # a bound's own evaluation made an upper bound (GROW, underflow)
+        return x * GROW + 4 * TINY
+
+    def libm(v):  # the library function's own error, LIBM_ULPS ulps of its result
+        return LIBM * fabs(v) + LIBM_ULPS * TINY
+
+    v, e, const = {}, {}, {}
+    for k in range(F.n_instructions()):
+        op = F.instruction_id(k)
+        i = F.instruction_input(k)
+        o = F.instruction_output(k)
+        if op == ca.OP_INPUT:
+            nm = names[i[0]]
+            v[o[0]] = x_nz[i[0]][i[1]]
+            e[o[0]] = r_nz[nm][i[1]] if nm in r_nz else zero
+            const.pop(o[0], None)
+            continue
+        if op == ca.OP_OUTPUT:
+            out_v[o[0]][o[1]], out_e[o[0]][o[1]] = v[i[0]], e[i[0]]
+            continue
+        if op == ca.OP_CONST:
+            c = float(F.instruction_constant(k))
+            v[o[0]] = ca.SX(c)
+            e[o[0]] = zero if _short_dyadic(c) else ca.SX(2 * U * abs(c))
+            const[o[0]] = c
+            continue
+        a, ea = v[i[0]], e[i[0]]
+        binary = len(i) > 1 and op not in _UNARY
+        b, eb = (v[i[1]], e[i[1]]) if binary else (None, None)
+        val = ca.SX.binary(op, a, b) if binary else ca.SX.unary(op, a)
+        err = _bound(ca, op, val, a, ea, b, eb, const.get(i[1]) if binary else None, up, libm, zero, inf)
+        v[o[0]], e[o[0]] = val, err
+        const.pop(o[0], None)
+    outs, bounds = [], []
+    for j in range(F.n_out()):
+        sp = F.sparsity_out(j)
+        outs.append(ca.densify(ca.SX(sp, ca.vertcat(*out_v[j])) if out_v[j] else ca.SX(sp)))
+        bounds.append(ca.densify(ca.SX(sp, ca.vertcat(*out_e[j])) if out_e[j] else ca.SX(sp)))
+    return ca.Function(name or f"{F.name()}_enclosure", xs + [rs[nm] for nm in uncertain], outs + bounds,
+                       names + ["r_" + nm for nm in uncertain],
+                       [F.name_out(j) for j in range(F.n_out())] + ["e_" + F.name_out(j) for j in range(F.n_out())])
+
+
+_UNARY = set()  # filled below: the operations of one operand (CasADi lists two inputs for some)
+
+
+def _bound(ca, op, val, a, ea, b, eb, cb, up, libm, zero, inf):
+    """The bound of one operation's result (the module's docstring): val = op(a, b) as
+    computed, a and b within ea, eb of their exact values; cb: b's value where b is a
+    constant of the graph (a power's exponent)."""
+    fabs, if_else, av = ca.fabs, ca.if_else, ca.fabs(val)
+    rnd = U * av  # one correctly rounded operation
+    if op in (ca.OP_ASSIGN, ca.OP_NEG, ca.OP_FABS):
+        return ea
+    if op == ca.OP_TWICE:
+        return 2 * ea
+    if op in (ca.OP_ADD, ca.OP_SUB):
+        return up(ea + eb + rnd)
+    if op == ca.OP_MUL:
+        return up(fabs(a) * eb + fabs(b) * ea + ea * eb + rnd + TINY)
+    if op == ca.OP_SQ:
+        return up(2 * fabs(a) * ea + ea * ea + rnd + TINY)
+    if op == ca.OP_DIV:
+        den = fabs(b) - eb
+        return if_else(den > 0, up((ea + av * eb) / den + rnd + TINY), inf)
+    if op == ca.OP_INV:
+        den = fabs(a) - ea
+        return if_else(den > 0, up(av * ea / den + rnd + TINY), inf)
+    if op == ca.OP_SQRT:
+        return if_else(ea == 0, rnd, if_else(a - ea > 0, up(ea / val + rnd), inf))
+    if op == ca.OP_SIN:
+        return up(ea * (fabs(ca.cos(a)) + ea + LIBM) + libm(val))
+    if op == ca.OP_COS:
+        return up(ea * (fabs(ca.sin(a)) + ea + LIBM) + libm(val))
+    if op == ca.OP_TAN:
+        den = fabs(ca.cos(a)) - ea - LIBM
+        return if_else(den > 0, up(ea / (den * den) + libm(val)), inf)
+    if op == ca.OP_EXP:
+        return if_else(ea <= 1, up(ea * av * (1 + LIBM) * (1 + ea + ea * ea) + libm(val)), inf)
+    if op == ca.OP_EXPM1:  # derivative exp(x)
+        return if_else(ea <= 1, up(ea * (av + 1) * (1 + LIBM) * (1 + ea + ea * ea) + libm(val)), inf)
+    if op == ca.OP_LOG:
+        den = a - ea
+        return if_else(den > 0, up(ea / den + libm(val)), inf)
+    if op == ca.OP_LOG1P:
+        den = 1 + a - ea
+        return if_else(den > 0, up(ea / den + libm(val)), inf)
+    if op in (ca.OP_ATAN, ca.OP_TANH):  # |derivative| <= 1
+        return up(ea + libm(val))
+    if op == ca.OP_ERF:  # |derivative| <= 2 / sqrt(pi) < 1.13
+        return up(1.13 * ea + libm(val))
+    if op in (ca.OP_ASIN, ca.OP_ACOS):
+        t = fabs(a) + ea
+        den = (1 - t) * (1 + t)
+        return if_else(ea == 0, libm(val), if_else(den > 0, up(ea / ca.sqrt(den) + libm(val)), inf))
+    if op in (ca.OP_SINH, ca.OP_COSH):
+        return up(ea * ca.cosh(fabs(a) + ea) * (1 + LIBM) + libm(val))
+    if op == ca.OP_ATAN2:  # val = atan2(a, b): a = y, b = x
+        s = ea + eb
+        r = ca.sqrt(a * a + b * b) * (1 - 8 * U)
+        cut = ca.logic_and(b - eb < 0, fabs(a) <= ea)
+        return if_else(s == 0, libm(val), if_else(ca.logic_and(r - s > 0, ca.logic_not(cut)),
+                                                  up(s / (r - s) + libm(val)), inf))
+    if op == ca.OP_CONSTPOW and cb is not None:
+        return _constpow(ca, a, ea, cb, val, up, libm, inf)
+    if op == ca.OP_POW:
+        if cb is not None:
+            return _constpow(ca, a, ea, cb, val, up, libm, inf)
+        return if_else(ca.logic_and(ea == 0, eb == 0), libm(val), inf)
+    if op in (ca.OP_FMIN, ca.OP_FMAX):  # Lipschitz 1 in each operand: max(ea, eb) <= ea + eb
+        return up(ea + eb)
+    if op in (ca.OP_LT, ca.OP_LE, ca.OP_EQ, ca.OP_NE):  # exact where it cannot flip
+        apart = fabs(a - b) * (1 - 4 * U) > ea + eb
+        return if_else(ca.logic_or(ca.logic_and(ea == 0, eb == 0), apart), zero, inf)
+    if op in (ca.OP_NOT,):
+        return ea
+    if op in (ca.OP_AND, ca.OP_OR):  # a boolean's bound is 0 (exact) or inf
+        return ea + eb
+    if op == ca.OP_IF_ELSE_ZERO:
+        return if_else(ea == 0, if_else(a != 0, eb, zero), inf)
+    if op == ca.OP_SIGN:
+        return if_else(ca.logic_or(ea == 0, fabs(a) > ea), zero, inf)
+    if op in (ca.OP_FLOOR, ca.OP_CEIL, ca.OP_COPYSIGN, ca.OP_FMOD):  # exact on exact operands
+        exact = ea == 0 if eb is None else ca.logic_and(ea == 0, eb == 0)
+        return if_else(exact, zero, inf)
+    return inf  # an operation this module does not bound
+
+
+def _constpow(ca, a, ea, c, val, up, libm, inf):
+    """a^c for a constant c: its derivative's magnitude over the box at its ends."""
+    fabs, if_else = ca.fabs, ca.if_else
+    if c == 0:
+        return ca.SX(0.0)
+    if c == 1:
+        return ea
+    if c == math.floor(c) and c > 0:  # an integer power: |c| (|a| + ea)^(c - 1) ea, any sign
+        d = abs(c) * (fabs(a) + ea) ** (c - 1) * (1 + LIBM)
+        return up(d * ea + libm(val))
+    if c == math.floor(c):  # a negative integer: |c| (|a| - ea)^(c - 1), the box clear of 0
+        lo = fabs(a) - ea
+        return if_else(lo > 0, up(abs(c) * lo ** (c - 1) * (1 + LIBM) * ea + libm(val)), inf)
+    lo = a - ea  # any other: a positive box, the derivative monotone: both ends summed
+    d = abs(c) * (lo ** (c - 1) + (a + ea) ** (c - 1)) * (1 + LIBM)
+    return if_else(ea == 0, libm(val), if_else(lo > 0, up(d * ea + libm(val)), inf))
+
+
+def _fill_unary():
+    import casadi as ca
+
+    for nm in ("ASSIGN", "NEG", "FABS", "TWICE", "SQ", "SQRT", "SIN", "COS", "TAN", "EXP", "EXPM1", "LOG",
+               "LOG1P", "ATAN", "TANH", "ERF", "ASIN", "ACOS", "SINH", "COSH", "ASINH", "ACOSH", "ATANH",
+               "INV", "NOT", "SIGN", "FLOOR", "CEIL", "ERFINV"):
+        _UNARY.add(getattr(ca, "OP_" + nm))
+
+
+_fill_unary()
+
+
+class Enclosure:
+    """An enclosure Function over a batch: compiled C with a loop over the sets (cached per
+    machine by the source's hash, as gyro.ode.compiled), or CasADi's own evaluation without
+    a compiler. Call with one array per input (sets, nonzeros), then the radii; returns
+    (values, bounds), each a list of (sets, rows, cols) arrays, a bound +inf wherever it or
+    its value is not finite."""
+
+    def __init__(self, G, n_values: int):
+        self.G, self.n_values = G, n_values
+        self.sizes_in = [G.nnz_in(i) for i in range(G.n_in())]
+        self.shapes_out = [G.size_out(j) for j in range(G.n_out())]
+        self.lib = None
+        try:
+            self.fn = self._compile()
+        except Exception as exc:  # noqa: BLE001 (CompilerUnavailable, or a build that fails: CasADi answers)
+            from gyro import cbackend
+
+            if not isinstance(exc, cbackend.CompilerUnavailable):
+                raise
+            self.fn = None
+
+    def _compile(self):
+        import ctypes
+        import hashlib
+
+        import casadi as ca
+
+        from gyro import cbackend
+
+        cbackend._available()
+        G = self.G
+        cg = ca.CodeGenerator(G.name(), {"with_header": False, "casadi_int": "long long int"})
+        cg.add(G)
+        text = cg.dump()
+        sz_arg, sz_res, sz_iw, sz_w = (max(k, 1) for k in (G.sz_arg(), G.sz_res(), G.sz_iw(), G.sz_w()))
+        nin, nout = G.n_in(), G.n_out()
+        lines = [f"\nCASADI_SYMBOL_EXPORT int {G.name()}_batch(long long n, const double* const* in, double* const* out) {{",
+                 f"  const casadi_real* arg[{max(sz_arg, nin)}] = {{0}}; casadi_real* res[{max(sz_res, nout)}] = {{0}};",
+                 f"  casadi_int iw[{sz_iw}]; casadi_real w[{sz_w}];",
+                 "  for (long long k = 0; k < n; ++k) {"]
+        lines += [f"    arg[{i}] = in[{i}] + k * {G.nnz_in(i)};" for i in range(nin)]
+        lines += [f"    res[{j}] = out[{j}] + k * {G.nnz_out(j)};" for j in range(nout)]
+        lines += [f"    if ({G.name()}(arg, res, iw, w, 0)) return 1;", "  }", "  return 0;", "}", ""]
+        text += "\n".join(lines)
+        digest = hashlib.sha256(text.encode()).hexdigest()[:16]
+        src = cbackend._writable_cache() / "casadi-sources" / f"{G.name()}-{digest}.c"
+        if not src.exists() or src.read_text() != text:
+            src.parent.mkdir(parents=True, exist_ok=True)
+            tmp = src.with_suffix(f".{os.getpid()}.tmp")
+            tmp.write_text(text)
+            os.replace(tmp, src)
+        # -O1 (gyro.ode.compiled's reason: straight-line code, a compile of seconds)
+        lib = cbackend._shared(f"{G.name()}-{digest}", (src,), (), ("-O1",),
+                               notice=f"the generated C of the rounding enclosure {G.name()}")
+        self.lib = lib
+        fn = getattr(lib, f"{G.name()}_batch")
+        fn.restype = ctypes.c_int
+        return fn
+
+    def __call__(self, *inputs):
+        n = max(np.asarray(x).reshape(-1, k).shape[0] if k else 1 for x, k in zip(inputs, self.sizes_in))
+        args = [np.ascontiguousarray(np.broadcast_to(np.asarray(x, dtype=float).reshape(-1, k), (n, k)))
+                for x, k in zip(inputs, self.sizes_in)]
+        flat = [np.empty((n, r * c)) for r, c in self.shapes_out]
+        if self.fn is not None:
+            import ctypes
+
+            P = ctypes.POINTER(ctypes.c_double)
+            ins = (P * len(args))(*[a.ctypes.data_as(P) for a in args])
+            outs = (P * len(flat))(*[o.ctypes.data_as(P) for o in flat])
+            with np.errstate(all="ignore"):
+                if self.fn(ctypes.c_longlong(n), ins, outs):
+                    raise ArithmeticError(f"{self.G.name()}: the compiled enclosure failed")
+        elif n:
+            res = self.G.map(n, "serial")(*[a.T for a in args])
+            res = res if isinstance(res, tuple) else (res,)
+            for o, r in zip(flat, res):
+                o[:] = np.asarray(r).T
+        shaped = [o.reshape(n, c, r).transpose(0, 2, 1) for o, (r, c) in zip(flat, self.shapes_out)]
+        values, bounds = shaped[:self.n_values], shaped[self.n_values:]
+        bounds = [np.where(np.isfinite(b) & np.isfinite(x), b, np.inf) for b, x in zip(bounds, values)]
+        return values, bounds
+
+
+_CACHE: dict = {}
+_LOCK = threading.Lock()
+
+
+def enclosed(model, fname: str, uncertain=("qe",)) -> Enclosure:
+    """The Enclosure of a model's generated function `fname` (its CasADi twin, model.casadi),
+    radii on the inputs `uncertain` (those it has): cached per model and function."""
+    key = (model.name, str(getattr(model, "directory", "")), fname, tuple(uncertain))
+    with _LOCK:
+        if key not in _CACHE:
+            F = getattr(model.casadi, fname)
+            has = [nm for nm in uncertain if nm in [F.name_in(i) for i in range(F.n_in())]]
+            label = re.sub(r"\W", "_", f"gyro_enclosure_{model.name}_{fname}")
+            _CACHE[key] = Enclosure(enclosure(F, has, label), F.n_out())
+        return _CACHE[key]
+
+
+KRAWCZYK_TRIES = 4  # boxes tried per set (each one enclosure of the Newton system over it)
+
+
+def equilibrium_radius(model, P, qe) -> np.ndarray:
+    """Per set and equilibrium coordinate, a radius within which the exact equilibrium lies
+    (of the exact equations at the double parameters P): +inf where none is proven.
+
+    Krawczyk's test on the model's Newton system (r, Kn) = equilibrium_system(P, q), r the
+    residual rows of the unknowns and Kn = -dr/dq: with X a computed inverse of Kn at qe,
+    rho >= |r(qe)| the residual's enclosure at qe (|r| + its running bound) and, over the box
+    |q - qe| <= d, R >= |I - X Kn(q)| (|I - X Kn| as computed, plus (n + 2) u |X| |Kn| for
+    that product's rounding, plus |X| times Kn's enclosure over the box), the Krawczyk map
+    qe + X r(qe) + (I - X Kn(box)) (box - qe) lies within |X| rho + R d of qe. Where that is
+    at most d componentwise, the box holds an exact equilibrium (Brouwer) and every
+    equilibrium of the box lies within |X| rho + R d of qe (Krawczyk): that is the radius.
+    Rigorous (both enclosures are, the sums here inflated for their own rounding); the box
+    is 2 |X| rho first, then twice the last map's radius, KRAWCZYK_TRIES boxes at most."""
+    P, qe = np.asarray(P, dtype=float), np.asarray(qe, dtype=float)
+    N, ne = qe.shape
+    out = np.full((N, ne), np.inf)
+    if ne == 0:
+        return out
+    if "equilibrium_system" not in model.meta["functions"]:
+        return out  # generated before the Newton system was emitted: nothing proven
+    S = enclosed(model, "equilibrium_system")
+    (r, Kn), (er, _) = S(P, qe, np.zeros_like(qe))
+    r, er = r[:, :, 0], er[:, :, 0]
+    live = np.all(np.isfinite(qe), axis=1) & np.all(np.isfinite(er), axis=1) & np.all(np.isfinite(Kn), axis=(1, 2))
+    grow = 1 + 4 * (ne + 2) * U
+    X = np.full_like(Kn, np.nan)
+    with np.errstate(all="ignore"):
+        for k in np.flatnonzero(live):  # per set: a singular Kn leaves that set unproven
+            try:
+                X[k] = np.linalg.inv(Kn[k])
+            except np.linalg.LinAlgError:
+                pass
+        live &= np.all(np.isfinite(X), axis=(1, 2))
+        aX = np.abs(X)
+        rho = (np.abs(r) + er) * GROW
+        base = np.einsum("bij,bj->bi", aX, rho) * grow + 4 * ne * TINY  # |X| rho
+        formed = np.abs(np.eye(ne) - X @ Kn) + (ne + 2) * U * grow * (aX @ np.abs(Kn))
+        d = 2 * base
+        todo = np.flatnonzero(live)
+        for _ in range(KRAWCZYK_TRIES):
+            if todo.size == 0:
+                break
+            _, (_, eK) = S(P[todo], qe[todo], d[todo])
+            R = (formed[todo] + aX[todo] @ eK) * grow
+            reach = (base[todo] + np.einsum("bij,bj->bi", R, d[todo])) * grow + 4 * ne * TINY
+            inside = np.all(reach <= d[todo], axis=1) & np.all(np.isfinite(reach), axis=1)
+            out[todo[inside]] = reach[inside]
+            d[todo] = 2 * np.where(np.isfinite(reach), reach, np.inf)
+            todo = todo[~inside & np.all(np.isfinite(d[todo]), axis=1)]
+    return out
+
+
+def operator_rounding(model, P, qe, M, D, K):
+    """An entrywise bound of |X - X_exact| for the operator X = M, D, K the runtime formed at
+    (P, qe) (gyro.equilibrium.operators: the model's C or its NumPy), X_exact the exact
+    operator at the exact equilibrium of the double parameters P: the operator's CasADi twin
+    enclosed (`enclosure`) over the box |q - qe| <= equilibrium_radius(P, qe), plus the
+    difference of the operator used from the twin (|X - X_twin| + e_twin bounds |X - X_exact|
+    whatever the C compiler or NumPy did). Rigorous up to libm's assumed accuracy
+    (LIBM_ULPS); +inf for every entry that depends on qe where no equilibrium is proven."""
+    P, qe = np.asarray(P, dtype=float), np.asarray(qe, dtype=float)
+    delta = equilibrium_radius(model, P, qe)
+    E = enclosed(model, "operator")
+    twin, bounds = E(P, qe, delta)
+    out = []
+    with np.errstate(all="ignore"):
+        for X, T, e in zip((M, D, K), twin, bounds):
+            d = (np.abs(np.asarray(X) - T) + e) * GROW
+            out.append(np.where(np.isfinite(d), d, np.inf))
+    return tuple(out)

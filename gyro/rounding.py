@@ -72,11 +72,13 @@ def _short_dyadic(c: float) -> bool:
     return s == math.floor(s) and abs(s) < 2.0**53
 
 
-def enclosure(F, uncertain=None, name: str | None = None):
+def enclosure(F, uncertain=None, name: str | None = None, keep=None):
     """The Function (inputs of F, then a radius for each input named in `uncertain` (all
     inputs where None), laid out as that input) -> (each output of F densified, then a
-    bound of each output's rounding, densified): the module's docstring says how. An input
-    not in `uncertain` is exact as given."""
+    bound of each output's rounding, densified, named "e_" + the output's name): the
+    module's docstring says how. An input not in `uncertain` is exact as given. `keep`: the
+    names of the outputs to return (of both kinds, in that order; None: all), the algorithm
+    pruned to what they need."""
     import casadi as ca
 
     names = [F.name_in(i) for i in range(F.n_in())]
@@ -131,9 +133,11 @@ def enclosure(F, uncertain=None, name: str | None = None):
         sp = F.sparsity_out(j)
         outs.append(ca.densify(ca.SX(sp, ca.vertcat(*out_v[j])) if out_v[j] else ca.SX(sp)))
         bounds.append(ca.densify(ca.SX(sp, ca.vertcat(*out_e[j])) if out_e[j] else ca.SX(sp)))
-    return ca.Function(name or f"{F.name()}_enclosure", xs + [rs[nm] for nm in uncertain], outs + bounds,
-                       names + ["r_" + nm for nm in uncertain],
-                       [F.name_out(j) for j in range(F.n_out())] + ["e_" + F.name_out(j) for j in range(F.n_out())])
+    out_names = [F.name_out(j) for j in range(F.n_out())] + ["e_" + F.name_out(j) for j in range(F.n_out())]
+    chosen = list(range(len(out_names))) if keep is None else [out_names.index(nm) for nm in keep]
+    return ca.Function(name or f"{F.name()}_enclosure", xs + [rs[nm] for nm in uncertain],
+                       [(outs + bounds)[j] for j in chosen], names + ["r_" + nm for nm in uncertain],
+                       [out_names[j] for j in chosen])
 
 
 _UNARY = set()  # filled below: the operations of one operand (CasADi lists two inputs for some)
@@ -255,10 +259,10 @@ class Enclosure:
     """An enclosure Function over a batch: compiled C with a loop over the sets (cached per
     machine by the source's hash, as gyro.ode.compiled), or CasADi's own evaluation without
     a compiler. Call with one array per input (sets, nonzeros), then the radii; returns
-    (values, bounds), each a list of (sets, rows, cols) arrays, a bound +inf wherever it or
-    its value is not finite."""
+    (values, bounds), each a list of (sets, rows, cols) arrays, a bound +inf wherever it (or,
+    where the values are kept, its value) is not finite."""
 
-    def __init__(self, G, n_values: int):
+    def __init__(self, G, n_values: int):  # the first n_values outputs are values, the rest bounds
         self.G, self.n_values = G, n_values
         self.sizes_in = [G.nnz_in(i) for i in range(G.n_in())]
         self.shapes_out = [G.size_out(j) for j in range(G.n_out())]
@@ -276,32 +280,18 @@ class Enclosure:
         import ctypes
         import hashlib
 
-        import casadi as ca
-
         from gyro import cbackend
 
         cbackend._available()
         G = self.G
-        cg = ca.CodeGenerator(G.name(), {"with_header": False, "casadi_int": "long long int"})
-        cg.add(G)
-        text = cg.dump()
-        sz_arg, sz_res, sz_iw, sz_w = (max(k, 1) for k in (G.sz_arg(), G.sz_res(), G.sz_iw(), G.sz_w()))
-        nin, nout = G.n_in(), G.n_out()
-        lines = [f"\nCASADI_SYMBOL_EXPORT int {G.name()}_batch(long long n, const double* const* in, double* const* out) {{",
-                 f"  const casadi_real* arg[{max(sz_arg, nin)}] = {{0}}; casadi_real* res[{max(sz_res, nout)}] = {{0}};",
-                 f"  casadi_int iw[{sz_iw}]; casadi_real w[{sz_w}];",
-                 "  for (long long k = 0; k < n; ++k) {"]
-        lines += [f"    arg[{i}] = in[{i}] + k * {G.nnz_in(i)};" for i in range(nin)]
-        lines += [f"    res[{j}] = out[{j}] + k * {G.nnz_out(j)};" for j in range(nout)]
-        lines += [f"    if ({G.name()}(arg, res, iw, w, 0)) return 1;", "  }", "  return 0;", "}", ""]
-        text += "\n".join(lines)
+        text = _simd_source(G, f"{G.name()}_batch")
         digest = hashlib.sha256(text.encode()).hexdigest()[:16]
         src = cbackend._writable_cache() / "casadi-sources" / f"{G.name()}-{digest}.c"
         if not src.exists() or src.read_text() != text:
             src.parent.mkdir(parents=True, exist_ok=True)
             tmp = src.with_suffix(f".{os.getpid()}.tmp")
             tmp.write_text(text)
-            os.replace(tmp, src)
+            os.replace(tmp, src)  # atomic: another process may write the same bytes
         # -O1 (gyro.ode.compiled's reason: straight-line code, a compile of seconds)
         lib = cbackend._shared(f"{G.name()}-{digest}", (src,), (), ("-O1",),
                                notice=f"the generated C of the rounding enclosure {G.name()}")
@@ -331,7 +321,9 @@ class Enclosure:
                 o[:] = np.asarray(r).T
         shaped = [o.reshape(n, c, r).transpose(0, 2, 1) for o, (r, c) in zip(flat, self.shapes_out)]
         values, bounds = shaped[:self.n_values], shaped[self.n_values:]
-        bounds = [np.where(np.isfinite(b) & np.isfinite(x), b, np.inf) for b, x in zip(bounds, values)]
+        bounds = [np.where(np.isfinite(b), b, np.inf) for b in bounds]
+        if len(values) == len(bounds):  # each value beside its bound: a value not finite has none
+            bounds = [np.where(np.isfinite(x), b, np.inf) for b, x in zip(bounds, values)]
         return values, bounds
 
 
@@ -339,16 +331,20 @@ _CACHE: dict = {}
 _LOCK = threading.Lock()
 
 
-def enclosed(model, fname: str, uncertain=("qe",)) -> Enclosure:
+def enclosed(model, fname: str, uncertain=("qe",), keep=None) -> Enclosure:
     """The Enclosure of a model's generated function `fname` (its CasADi twin, model.casadi),
-    radii on the inputs `uncertain` (those it has): cached per model and function."""
-    key = (model.name, str(getattr(model, "directory", "")), fname, tuple(uncertain))
+    radii on the inputs `uncertain` (those it has), the outputs `keep` (enclosure's): cached
+    per model, function and choice."""
+    key = (model.name, str(getattr(model, "directory", "")), fname, tuple(uncertain), keep and tuple(keep))
     with _LOCK:
         if key not in _CACHE:
             F = getattr(model.casadi, fname)
             has = [nm for nm in uncertain if nm in [F.name_in(i) for i in range(F.n_in())]]
-            label = re.sub(r"\W", "_", f"gyro_enclosure_{model.name}_{fname}")
-            _CACHE[key] = Enclosure(enclosure(F, has, label), F.n_out())
+            outs = [F.name_out(j) for j in range(F.n_out())] if keep is None else list(keep)
+            tag = "" if keep is None and list(has) == ["qe"] else "_" + "_".join(has + ["to"] + outs)
+            label = re.sub(r"\W", "_", f"gyro_enclosure_{model.name}_{fname}{tag}")
+            G = enclosure(F, has, label, keep)
+            _CACHE[key] = Enclosure(G, sum(not nm.startswith("e_") for nm in outs))
         return _CACHE[key]
 
 
@@ -376,18 +372,26 @@ def equilibrium_radius(model, P, qe) -> np.ndarray:
         return out
     if "equilibrium_system" not in model.meta["functions"]:
         return out  # generated before the Newton system was emitted: nothing proven
-    S = enclosed(model, "equilibrium_system")
-    (r, Kn), (er, _) = S(P, qe, np.zeros_like(qe))
+    F = model.casadi.equilibrium_system
+    r_name, k_name = F.name_out(0), F.name_out(1)
+    # at qe: the residual, Kn and the residual's bound (qe exact); over a box: Kn's bound alone
+    point = enclosed(model, "equilibrium_system", (), (r_name, k_name, "e_" + r_name))
+    box = enclosed(model, "equilibrium_system", ("qe",), ("e_" + k_name,))
+    (r, Kn), (er,) = point(P, qe)
     r, er = r[:, :, 0], er[:, :, 0]
     live = np.all(np.isfinite(qe), axis=1) & np.all(np.isfinite(er), axis=1) & np.all(np.isfinite(Kn), axis=(1, 2))
     grow = 1 + 4 * (ne + 2) * U
     X = np.full_like(Kn, np.nan)
     with np.errstate(all="ignore"):
-        for k in np.flatnonzero(live):  # per set: a singular Kn leaves that set unproven
-            try:
-                X[k] = np.linalg.inv(Kn[k])
-            except np.linalg.LinAlgError:
-                pass
+        k = np.flatnonzero(live)
+        try:
+            X[k] = np.linalg.inv(Kn[k])
+        except np.linalg.LinAlgError:  # a singular Kn somewhere: set by set, that set unproven
+            for j in k:
+                try:
+                    X[j] = np.linalg.inv(Kn[j])
+                except np.linalg.LinAlgError:
+                    pass
         live &= np.all(np.isfinite(X), axis=(1, 2))
         aX = np.abs(X)
         rho = (np.abs(r) + er) * GROW
@@ -398,7 +402,7 @@ def equilibrium_radius(model, P, qe) -> np.ndarray:
         for _ in range(KRAWCZYK_TRIES):
             if todo.size == 0:
                 break
-            _, (_, eK) = S(P[todo], qe[todo], d[todo])
+            _, (eK,) = box(P[todo], qe[todo], d[todo])
             R = (formed[todo] + aX[todo] @ eK) * grow
             reach = (base[todo] + np.einsum("bij,bj->bi", R, d[todo])) * grow + 4 * ne * TINY
             inside = np.all(reach <= d[todo], axis=1) & np.all(np.isfinite(reach), axis=1)
@@ -426,3 +430,75 @@ def operator_rounding(model, P, qe, M, D, K):
             d = (np.abs(np.asarray(X) - T) + e) * GROW
             out.append(np.where(np.isfinite(d), d, np.inf))
     return tuple(out)
+
+
+LANES = 4  # sets per vector of the compiled enclosure (GCC's vector extension)
+
+_C_BINARY = {"OP_ADD": "{a} + {b}", "OP_SUB": "{a} - {b}", "OP_MUL": "{a} * {b}", "OP_DIV": "{a} / {b}",
+             "OP_LT": "B({a} < {b})", "OP_LE": "B({a} <= {b})", "OP_EQ": "B({a} == {b})",
+             "OP_NE": "B({a} != {b})", "OP_AND": "B(({a} != 0) & ({b} != 0))",
+             "OP_OR": "B(({a} != 0) | ({b} != 0))", "OP_IF_ELSE_ZERO": "(vd)((vl){b} & ({a} != 0))",
+             "OP_FMIN": "L2(fmin, {a}, {b})", "OP_FMAX": "L2(fmax, {a}, {b})", "OP_POW": "L2(pow, {a}, {b})",
+             "OP_CONSTPOW": "L2(pow, {a}, {b})", "OP_ATAN2": "L2(atan2, {a}, {b})",
+             "OP_COPYSIGN": "L2(copysign, {a}, {b})", "OP_FMOD": "L2(fmod, {a}, {b})"}
+_C_UNARY = {"OP_ASSIGN": "{a}", "OP_NEG": "-{a}", "OP_TWICE": "{a} + {a}", "OP_SQ": "{a} * {a}",
+            "OP_INV": "1.0 / {a}", "OP_FABS": "(vd)((vl){a} & 0x7fffffffffffffffLL)",
+            "OP_NOT": "B({a} == 0)"}
+_C_LIBM = {"OP_SQRT": "sqrt", "OP_SIN": "sin", "OP_COS": "cos", "OP_TAN": "tan", "OP_EXP": "exp",
+           "OP_EXPM1": "expm1", "OP_LOG": "log", "OP_LOG1P": "log1p", "OP_ATAN": "atan", "OP_TANH": "tanh",
+           "OP_ERF": "erf", "OP_ASIN": "asin", "OP_ACOS": "acos", "OP_SINH": "sinh", "OP_COSH": "cosh",
+           "OP_FLOOR": "floor", "OP_CEIL": "ceil", "OP_SIGN": "SIGN"}
+
+
+def _simd_source(G, entry: str) -> str:
+    """C99 of an SX Function over a batch, LANES sets at a time in GCC's vector extension:
+    one statement per instruction of G's algorithm, in its order, each the one IEEE operation
+    (ISO C99: no contraction, no reassociation; libm's functions lane by lane), single
+    assignment, so the compiler keeps the values in registers. `entry(n, in, out)`: in[i] is
+    input i over the sets (sets, nonzeros), out[j] likewise."""
+    import casadi as ca
+
+    names = {getattr(ca, n): n for n in dir(ca) if n.startswith("OP_")}
+    L = LANES
+    head = [
+        "#include <math.h>",
+        f"typedef double vd __attribute__((vector_size({8 * L})));",
+        f"typedef long long vl __attribute__((vector_size({8 * L})));",
+        "#define B(m) __builtin_convertvector(-(m), vd)",
+        f"#define L1(f, x) ({{ vd _x = (x), _r; for (int _i = 0; _i < {L}; ++_i) _r[_i] = f(_x[_i]); _r; }})",
+        f"#define L2(f, x, y) ({{ vd _x = (x), _y = (y), _r; for (int _i = 0; _i < {L}; ++_i) "
+        "_r[_i] = f(_x[_i], _y[_i]); _r; })",
+        "static double SIGN(double x) { return x > 0 ? 1.0 : x < 0 ? -1.0 : x; }",
+        f"int {entry}(long long n, const double* const* in, double* const* out) {{",
+        f"  for (long long k = 0; k < n; k += {L}) {{",
+        f"    long long s[{L}];",
+        f"    for (int i = 0; i < {L}; ++i) s[i] = k + i < n ? k + i : n - 1;",
+    ]
+    body, reg = [], {}
+    for k in range(G.n_instructions()):
+        op = names[G.instruction_id(k)]
+        i, o = G.instruction_input(k), G.instruction_output(k)
+        if op == "OP_INPUT":
+            nnz = G.nnz_in(i[0])
+            lanes = ", ".join(f"in[{i[0]}][s[{q}] * {nnz} + {i[1]}]" for q in range(L))
+            expr = f"(vd){{{lanes}}}"
+        elif op == "OP_OUTPUT":
+            nnz = G.nnz_out(o[0])
+            body.append(f"    for (int i = 0; i < {L} && k + i < n; ++i) "
+                        f"out[{o[0]}][(k + i) * {nnz} + {o[1]}] = {reg[i[0]]}[i];")
+            continue
+        elif op == "OP_CONST":
+            c = float(G.instruction_constant(k))
+            lit = "INFINITY" if c == np.inf else "-INFINITY" if c == -np.inf else "NAN" if c != c else repr(c)
+            expr = f"((vd){{0}} + {lit})"
+        elif op in _C_UNARY:
+            expr = _C_UNARY[op].format(a=reg[i[0]])
+        elif op in _C_LIBM:
+            expr = f"L1({_C_LIBM[op]}, {reg[i[0]]})"
+        elif op in _C_BINARY:
+            expr = _C_BINARY[op].format(a=reg[i[0]], b=reg[i[1]])
+        else:
+            raise NotImplementedError(f"{G.name()}: no C for {op}")
+        body.append(f"    vd a{k} = {expr};")
+        reg[o[0]] = f"a{k}"
+    return "\n".join(head + body + ["  }", "  return 0;", "}", ""])

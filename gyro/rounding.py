@@ -267,14 +267,12 @@ class Enclosure:
         self.sizes_in = [G.nnz_in(i) for i in range(G.n_in())]
         self.shapes_out = [G.size_out(j) for j in range(G.n_out())]
         self.lib = None
+        from gyro import cbackend
+
         try:
             self.fn = self._compile()
-        except Exception as exc:  # noqa: BLE001 (CompilerUnavailable, or a build that fails: CasADi answers)
-            from gyro import cbackend
-
-            if not isinstance(exc, cbackend.CompilerUnavailable):
-                raise
-            self.fn = None
+        except (cbackend.CompilerUnavailable, NotImplementedError):  # no compiler, or an operation
+            self.fn = None  # _simd_source has no C for: CasADi's own evaluation answers
 
     def _compile(self):
         import ctypes
@@ -317,8 +315,8 @@ class Enclosure:
         elif n:
             res = self.G.map(n, "serial")(*[a.T for a in args])
             res = res if isinstance(res, tuple) else (res,)
-            for o, r in zip(flat, res):
-                o[:] = np.asarray(r).T
+            for o, r, (rows, cols) in zip(flat, res, self.shapes_out):  # (rows, sets * cols)
+                o[:] = np.asarray(r).reshape(rows, n, cols).transpose(1, 2, 0).reshape(n, rows * cols)
         shaped = [o.reshape(n, c, r).transpose(0, 2, 1) for o, (r, c) in zip(flat, self.shapes_out)]
         values, bounds = shaped[:self.n_values], shaped[self.n_values:]
         bounds = [np.where(np.isfinite(b), b, np.inf) for b in bounds]

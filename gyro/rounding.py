@@ -98,10 +98,10 @@ def enclosure(F, uncertain=None, name: str | None = None, keep=None):
     def up(x):  # a bound's own evaluation made an upper bound (GROW, underflow)
         return x * GROW + 4 * TINY
 
-    def libm(v):  # the library function's own error, LIBM_ULPS ulps of its result
-        return LIBM * fabs(v) + LIBM_ULPS * TINY
+    def libm(av):  # the library function's own error, LIBM_ULPS ulps of its result |v|
+        return LIBM * av + LIBM_ULPS * TINY
 
-    v, e, const = {}, {}, {}
+    v, e, const, absv = {}, {}, {}, {}
     for k in range(F.n_instructions()):
         op = F.instruction_id(k)
         i = F.instruction_input(k)
@@ -111,6 +111,7 @@ def enclosure(F, uncertain=None, name: str | None = None, keep=None):
             v[o[0]] = x_nz[i[0]][i[1]]
             e[o[0]] = r_nz[nm][i[1]] if nm in r_nz else zero
             const.pop(o[0], None)
+            absv.pop(o[0], None)
             continue
         if op == ca.OP_OUTPUT:
             out_v[o[0]][o[1]], out_e[o[0]][o[1]] = v[i[0]], e[i[0]]
@@ -120,13 +121,19 @@ def enclosure(F, uncertain=None, name: str | None = None, keep=None):
             v[o[0]] = ca.SX(c)
             e[o[0]] = zero if _short_dyadic(c) else ca.SX(2 * U * abs(c))
             const[o[0]] = c
+            absv.pop(o[0], None)
             continue
         a, ea = v[i[0]], e[i[0]]
         binary = len(i) > 1 and op not in _UNARY
         b, eb = (v[i[1]], e[i[1]]) if binary else (None, None)
         val = ca.SX.binary(op, a, b) if binary else ca.SX.unary(op, a)
-        err = _bound(ca, op, val, a, ea, b, eb, const.get(i[1]) if binary else None, up, libm, zero, inf)
-        v[o[0]], e[o[0]] = val, err
+        # |a|, |b|, |val| made once per value and shared by its uses (an unused one is pruned)
+        aa = absv[i[0]] if i[0] in absv else absv.setdefault(i[0], fabs(a))
+        ab = (absv[i[1]] if i[1] in absv else absv.setdefault(i[1], fabs(b))) if binary else None
+        av = fabs(val)
+        err = _bound(ca, op, val, a, ea, b, eb, const.get(i[1]) if binary else None, up, libm, zero, inf,
+                     aa, ab, av)
+        v[o[0]], e[o[0]], absv[o[0]] = val, err, av
         const.pop(o[0], None)
     outs, bounds = [], []
     for j in range(F.n_out()):
@@ -143,11 +150,11 @@ def enclosure(F, uncertain=None, name: str | None = None, keep=None):
 _UNARY = set()  # filled below: the operations of one operand (CasADi lists two inputs for some)
 
 
-def _bound(ca, op, val, a, ea, b, eb, cb, up, libm, zero, inf):
+def _bound(ca, op, val, a, ea, b, eb, cb, up, libm, zero, inf, aa, ab, av):
     """The bound of one operation's result (the module's docstring): val = op(a, b) as
     computed, a and b within ea, eb of their exact values; cb: b's value where b is a
-    constant of the graph (a power's exponent)."""
-    fabs, if_else, av = ca.fabs, ca.if_else, ca.fabs(val)
+    constant of the graph (a power's exponent); aa, ab, av: |a|, |b|, |val|."""
+    fabs, if_else = ca.fabs, ca.if_else
     rnd = U * av  # one correctly rounded operation
     if op in (ca.OP_ASSIGN, ca.OP_NEG, ca.OP_FABS):
         return ea
@@ -156,56 +163,56 @@ def _bound(ca, op, val, a, ea, b, eb, cb, up, libm, zero, inf):
     if op in (ca.OP_ADD, ca.OP_SUB):
         return up(ea + eb + rnd)
     if op == ca.OP_MUL:
-        return up(fabs(a) * eb + fabs(b) * ea + ea * eb + rnd + TINY)
+        return up(aa * eb + ab * ea + ea * eb + rnd + TINY)
     if op == ca.OP_SQ:
-        return up(2 * fabs(a) * ea + ea * ea + rnd + TINY)
+        return up(2 * aa * ea + ea * ea + rnd + TINY)
     if op == ca.OP_DIV:
-        den = fabs(b) - eb
+        den = ab - eb
         return if_else(den > 0, up((ea + av * eb) / den + rnd + TINY), inf)
     if op == ca.OP_INV:
-        den = fabs(a) - ea
+        den = aa - ea
         return if_else(den > 0, up(av * ea / den + rnd + TINY), inf)
     if op == ca.OP_SQRT:
         return if_else(ea == 0, rnd, if_else(a - ea > 0, up(ea / val + rnd), inf))
     if op == ca.OP_SIN:
-        return up(ea * (fabs(ca.cos(a)) + ea + LIBM) + libm(val))
+        return up(ea * (fabs(ca.cos(a)) + ea + LIBM) + libm(av))
     if op == ca.OP_COS:
-        return up(ea * (fabs(ca.sin(a)) + ea + LIBM) + libm(val))
+        return up(ea * (fabs(ca.sin(a)) + ea + LIBM) + libm(av))
     if op == ca.OP_TAN:
         den = fabs(ca.cos(a)) - ea - LIBM
-        return if_else(den > 0, up(ea / (den * den) + libm(val)), inf)
+        return if_else(den > 0, up(ea / (den * den) + libm(av)), inf)
     if op == ca.OP_EXP:
-        return if_else(ea <= 1, up(ea * av * (1 + LIBM) * (1 + ea + ea * ea) + libm(val)), inf)
+        return if_else(ea <= 1, up(ea * av * (1 + LIBM) * (1 + ea + ea * ea) + libm(av)), inf)
     if op == ca.OP_EXPM1:  # derivative exp(x)
-        return if_else(ea <= 1, up(ea * (av + 1) * (1 + LIBM) * (1 + ea + ea * ea) + libm(val)), inf)
+        return if_else(ea <= 1, up(ea * (av + 1) * (1 + LIBM) * (1 + ea + ea * ea) + libm(av)), inf)
     if op == ca.OP_LOG:
         den = a - ea
-        return if_else(den > 0, up(ea / den + libm(val)), inf)
+        return if_else(den > 0, up(ea / den + libm(av)), inf)
     if op == ca.OP_LOG1P:
         den = 1 + a - ea
-        return if_else(den > 0, up(ea / den + libm(val)), inf)
+        return if_else(den > 0, up(ea / den + libm(av)), inf)
     if op in (ca.OP_ATAN, ca.OP_TANH):  # |derivative| <= 1
-        return up(ea + libm(val))
+        return up(ea + libm(av))
     if op == ca.OP_ERF:  # |derivative| <= 2 / sqrt(pi) < 1.13
-        return up(1.13 * ea + libm(val))
+        return up(1.13 * ea + libm(av))
     if op in (ca.OP_ASIN, ca.OP_ACOS):
         t = fabs(a) + ea
         den = (1 - t) * (1 + t)
-        return if_else(ea == 0, libm(val), if_else(den > 0, up(ea / ca.sqrt(den) + libm(val)), inf))
+        return if_else(ea == 0, libm(av), if_else(den > 0, up(ea / ca.sqrt(den) + libm(av)), inf))
     if op in (ca.OP_SINH, ca.OP_COSH):
-        return up(ea * ca.cosh(fabs(a) + ea) * (1 + LIBM) + libm(val))
+        return up(ea * ca.cosh(fabs(a) + ea) * (1 + LIBM) + libm(av))
     if op == ca.OP_ATAN2:  # val = atan2(a, b): a = y, b = x
         s = ea + eb
         r = ca.sqrt(a * a + b * b) * (1 - 8 * U)
         cut = ca.logic_and(b - eb < 0, fabs(a) <= ea)
-        return if_else(s == 0, libm(val), if_else(ca.logic_and(r - s > 0, ca.logic_not(cut)),
-                                                  up(s / (r - s) + libm(val)), inf))
+        return if_else(s == 0, libm(av), if_else(ca.logic_and(r - s > 0, ca.logic_not(cut)),
+                                                  up(s / (r - s) + libm(av)), inf))
     if op == ca.OP_CONSTPOW and cb is not None:
-        return _constpow(ca, a, ea, cb, val, up, libm, inf)
+        return _constpow(ca, a, ea, cb, av, up, libm, inf)
     if op == ca.OP_POW:
         if cb is not None:
-            return _constpow(ca, a, ea, cb, val, up, libm, inf)
-        return if_else(ca.logic_and(ea == 0, eb == 0), libm(val), inf)
+            return _constpow(ca, a, ea, cb, av, up, libm, inf)
+        return if_else(ca.logic_and(ea == 0, eb == 0), libm(av), inf)
     if op in (ca.OP_FMIN, ca.OP_FMAX):  # Lipschitz 1 in each operand: max(ea, eb) <= ea + eb
         return up(ea + eb)
     if op in (ca.OP_LT, ca.OP_LE, ca.OP_EQ, ca.OP_NE):  # exact where it cannot flip
@@ -225,7 +232,7 @@ def _bound(ca, op, val, a, ea, b, eb, cb, up, libm, zero, inf):
     return inf  # an operation this module does not bound
 
 
-def _constpow(ca, a, ea, c, val, up, libm, inf):
+def _constpow(ca, a, ea, c, av, up, libm, inf):
     """a^c for a constant c: its derivative's magnitude over the box at its ends."""
     fabs, if_else = ca.fabs, ca.if_else
     if c == 0:
@@ -234,13 +241,13 @@ def _constpow(ca, a, ea, c, val, up, libm, inf):
         return ea
     if c == math.floor(c) and c > 0:  # an integer power: |c| (|a| + ea)^(c - 1) ea, any sign
         d = abs(c) * (fabs(a) + ea) ** (c - 1) * (1 + LIBM)
-        return up(d * ea + libm(val))
+        return up(d * ea + libm(av))
     if c == math.floor(c):  # a negative integer: |c| (|a| - ea)^(c - 1), the box clear of 0
         lo = fabs(a) - ea
-        return if_else(lo > 0, up(abs(c) * lo ** (c - 1) * (1 + LIBM) * ea + libm(val)), inf)
+        return if_else(lo > 0, up(abs(c) * lo ** (c - 1) * (1 + LIBM) * ea + libm(av)), inf)
     lo = a - ea  # any other: a positive box, the derivative monotone: both ends summed
     d = abs(c) * (lo ** (c - 1) + (a + ea) ** (c - 1)) * (1 + LIBM)
-    return if_else(ea == 0, libm(val), if_else(lo > 0, up(d * ea + libm(val)), inf))
+    return if_else(ea == 0, libm(av), if_else(lo > 0, up(d * ea + libm(av)), inf))
 
 
 def _fill_unary():

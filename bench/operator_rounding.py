@@ -8,7 +8,8 @@ draw), the gyrohorizoncompass also at its sets near epsilon0 = 89.99 deg: how ma
 each beats, and the enclosure's ratio bound / actual (median, max) over the entries with an
 error. Then the cost per set of each on T sets of 0.5x..2x of the gyrohorizoncompass and the
 torsion gyrocompass (the operator, the probes, the enclosure: interleaved, the best of five runs each, this shared machine's load moving
-single runs by up to 2x). Writes bench/results/operator_rounding.json."""
+single runs by up to 2x), and of the frequencies' certificate with each (`certificate_timing`).
+Writes bench/results/operator_rounding.json."""
 from __future__ import annotations
 
 import argparse
@@ -112,6 +113,38 @@ def timing(name: str, n: int) -> dict:
     return out
 
 
+def certificate_timing(n: int, seed: int = 36) -> dict:
+    """The frequencies' certificate's shared part per set (gyro.questions.frequencies._exact:
+    the equilibrium, the operator, its rounding, the count at 0), with the enclosure and, in
+    the same run, with the two probes in its place, beside the exact level (the default
+    method) on the same sets: n sets of bench.levels' joint spread of the torsion
+    gyrocompass, interleaved, the best of five runs each."""
+    from bench.levels import joint
+    from gyro import ladder
+    from gyro.questions import frequencies as F
+
+    m = load("torsion_gyrocompass")
+    P = joint(n, seed)
+    probes = lambda model, P, qe, M, D, K: qep.equilibrium_moves(model, P, qe, M, D, K)  # noqa: E731
+    enclosure = rounding.operator_rounding
+    F._exact(m, P[:8])
+    runs = {"with_enclosure": lambda: F._exact(m, P), "with_probes": lambda: F._exact(m, P),
+            "exact_level": lambda: ladder.spectrum(m, P, "default")}
+    best = {k: np.inf for k in runs}
+    for _ in range(5):
+        for k, f in runs.items():
+            rounding.operator_rounding = probes if k == "with_probes" else enclosure
+            try:
+                t = time.perf_counter()
+                f()
+                best[k] = min(best[k], time.perf_counter() - t)
+            finally:
+                rounding.operator_rounding = enclosure
+    out = {f"{k}_us_per_set": v / n * 1e6 for k, v in best.items()}
+    out["sets"] = n
+    return out
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(prog="python -m bench.operator_rounding", description=__doc__.split("\n\n")[0])
     ap.add_argument("--sets", type=int, default=100)
@@ -127,6 +160,8 @@ def main(argv=None) -> None:
         t = timing(name, a.timing_sets)
         print(name, json.dumps(t), flush=True)
         out["timing"][name] = t
+    out["certificate"] = certificate_timing(a.timing_sets)
+    print("certificate", json.dumps(out["certificate"]), flush=True)
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "operator_rounding.json").write_text(json.dumps(out, indent=1) + "\n")
 

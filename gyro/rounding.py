@@ -31,9 +31,12 @@ and a bound e of its distance from the exact value, from its operands' (a, e_a),
 - any other operation (and pow with an uncertain exponent): +inf, never a finite guess.
 
 The bound itself is evaluated in double precision: every formula above combines
-non-negative quantities by at most a dozen roundings, each of which can make it smaller by
-at most a factor 1 + u, so each is multiplied by GROW = 1 + 32 u (and 4 * 2^-1074 added for
-the underflow of its own products) and stays an upper bound. A value or a bound that is not
+non-negative quantities, monotone in the operands' bounds, by at most 16 roundings, each of
+which can make it smaller by at most a factor 1 + u, and FLOOR = 16 * 2^-1074 added to each
+covers their underflow; so a computed bound is at least the exact one over (1 + u)^(16 T), T
+the instructions of F, and it is multiplied by 1 + 32 (T + 1) u (5.7e-12 for the torsion
+gyrocompass's operator) at the outputs and wherever it enters against the grain (a
+denominator |b| - e_b, a test e_a <= 1): an upper bound. A value or a bound that is not
 finite gives a bound of +inf (NaN included: `Enclosure` turns it so after the call).
 
 Constants of the graph: a double that is a short dyadic number (an integer or a fraction
@@ -60,7 +63,8 @@ U = 2.0**-53  # the unit roundoff of double precision, round to nearest
 TINY = 2.0**-1074  # the smallest subnormal: underflow's absolute error is at most half of it
 LIBM_ULPS = 4  # libm's error in sin, cos, tan, exp, log, atan, ..., taken in ulps (above)
 LIBM = 2 * LIBM_ULPS * U  # that relative to the result: an ulp of v is at most 2u |v|
-GROW = 1 + 32 * U  # each bound's own evaluation inflated by this: it stays an upper bound
+GROW = 1 + 32 * U  # a sum or product of a few non-negative doubles made an upper bound
+FLOOR = 16 * TINY  # added to each operation's bound: the underflow of its own evaluation
 
 
 def _short_dyadic(c: float) -> bool:
@@ -95,8 +99,20 @@ def enclosure(F, uncertain=None, name: str | None = None, keep=None):
     zero, inf = ca.SX(0.0), ca.SX(np.inf)
     fabs = ca.fabs
 
-    def up(x):  # a bound's own evaluation made an upper bound (GROW, underflow)
-        return x * GROW + 4 * TINY
+    # The bound's own rounding: each operation's formula combines non-negative numbers,
+    # monotone in its operands' bounds, by at most 16 roundings, each shrinking it by at most
+    # a factor 1 + u, and FLOOR added to each covers their underflow (below 2^-1022 a
+    # rounding loses at most 2^-1075 absolute): so the computed bound is at least the exact
+    # one over (1 + u)^(16 T), T the instructions, and `hi` (times 1 + 32 (T + 1) u >= that)
+    # makes it an upper bound where a bound enters against the grain (a denominator, a
+    # test), and at the outputs.
+    grow = 1 + 32 * (F.n_instructions() + 1) * U
+
+    def up(x):
+        return x + FLOOR
+
+    def hi(x):
+        return x * grow
 
     def libm(av):  # the library function's own error, LIBM_ULPS ulps of its result |v|
         return LIBM * av + LIBM_ULPS * TINY
@@ -114,7 +130,8 @@ def enclosure(F, uncertain=None, name: str | None = None, keep=None):
             absv.pop(o[0], None)
             continue
         if op == ca.OP_OUTPUT:
-            out_v[o[0]][o[1]], out_e[o[0]][o[1]] = v[i[0]], e[i[0]]
+            ex = e[i[0]]  # made an upper bound (hi), an exact output's 0 kept
+            out_v[o[0]][o[1]], out_e[o[0]][o[1]] = v[i[0]], (ex if ex.is_zero() else hi(ex) + FLOOR)
             continue
         if op == ca.OP_CONST:
             c = float(F.instruction_constant(k))
@@ -131,7 +148,7 @@ def enclosure(F, uncertain=None, name: str | None = None, keep=None):
         aa = absv[i[0]] if i[0] in absv else absv.setdefault(i[0], fabs(a))
         ab = (absv[i[1]] if i[1] in absv else absv.setdefault(i[1], fabs(b))) if binary else None
         av = fabs(val)
-        err = _bound(ca, op, val, a, ea, b, eb, const.get(i[1]) if binary else None, up, libm, zero, inf,
+        err = _bound(ca, op, val, a, ea, b, eb, const.get(i[1]) if binary else None, up, hi, libm, zero, inf,
                      aa, ab, av)
         v[o[0]], e[o[0]], absv[o[0]] = val, err, av
         const.pop(o[0], None)
@@ -150,7 +167,7 @@ def enclosure(F, uncertain=None, name: str | None = None, keep=None):
 _UNARY = set()  # filled below: the operations of one operand (CasADi lists two inputs for some)
 
 
-def _bound(ca, op, val, a, ea, b, eb, cb, up, libm, zero, inf, aa, ab, av):
+def _bound(ca, op, val, a, ea, b, eb, cb, up, hi, libm, zero, inf, aa, ab, av):
     """The bound of one operation's result (the module's docstring): val = op(a, b) as
     computed, a and b within ea, eb of their exact values; cb: b's value where b is a
     constant of the graph (a power's exponent); aa, ab, av: |a|, |b|, |val|."""
@@ -163,60 +180,60 @@ def _bound(ca, op, val, a, ea, b, eb, cb, up, libm, zero, inf, aa, ab, av):
     if op in (ca.OP_ADD, ca.OP_SUB):
         return up(ea + eb + rnd)
     if op == ca.OP_MUL:
-        return up(aa * eb + ab * ea + ea * eb + rnd + TINY)
+        return up((aa + ea) * eb + ab * ea + rnd)
     if op == ca.OP_SQ:
-        return up(2 * aa * ea + ea * ea + rnd + TINY)
+        return up((2 * aa + ea) * ea + rnd)
     if op == ca.OP_DIV:
-        den = ab - eb
-        return if_else(den > 0, up((ea + av * eb) / den + rnd + TINY), inf)
+        den = ab - hi(eb)
+        return if_else(den > 0, up((ea + av * eb) / den + rnd), inf)
     if op == ca.OP_INV:
-        den = aa - ea
-        return if_else(den > 0, up(av * ea / den + rnd + TINY), inf)
+        den = aa - hi(ea)
+        return if_else(den > 0, up(av * ea / den + rnd), inf)
     if op == ca.OP_SQRT:
-        return if_else(ea == 0, rnd, if_else(a - ea > 0, up(ea / val + rnd), inf))
+        return if_else(ea == 0, rnd, if_else(a - hi(ea) > 0, up(ea / val + rnd), inf))
     if op == ca.OP_SIN:
         return up(ea * (fabs(ca.cos(a)) + ea + LIBM) + libm(av))
     if op == ca.OP_COS:
         return up(ea * (fabs(ca.sin(a)) + ea + LIBM) + libm(av))
     if op == ca.OP_TAN:
-        den = fabs(ca.cos(a)) - ea - LIBM
+        den = fabs(ca.cos(a)) - hi(ea) - LIBM
         return if_else(den > 0, up(ea / (den * den) + libm(av)), inf)
     if op == ca.OP_EXP:
-        return if_else(ea <= 1, up(ea * av * (1 + LIBM) * (1 + ea + ea * ea) + libm(av)), inf)
+        return if_else(hi(ea) <= 1, up(ea * av * (1 + LIBM) * (1 + ea + ea * ea) + libm(av)), inf)
     if op == ca.OP_EXPM1:  # derivative exp(x)
-        return if_else(ea <= 1, up(ea * (av + 1) * (1 + LIBM) * (1 + ea + ea * ea) + libm(av)), inf)
+        return if_else(hi(ea) <= 1, up(ea * (av + 1) * (1 + LIBM) * (1 + ea + ea * ea) + libm(av)), inf)
     if op == ca.OP_LOG:
-        den = a - ea
+        den = a - hi(ea)
         return if_else(den > 0, up(ea / den + libm(av)), inf)
     if op == ca.OP_LOG1P:
-        den = 1 + a - ea
+        den = 1 + a - hi(ea)
         return if_else(den > 0, up(ea / den + libm(av)), inf)
     if op in (ca.OP_ATAN, ca.OP_TANH):  # |derivative| <= 1
         return up(ea + libm(av))
     if op == ca.OP_ERF:  # |derivative| <= 2 / sqrt(pi) < 1.13
         return up(1.13 * ea + libm(av))
     if op in (ca.OP_ASIN, ca.OP_ACOS):
-        t = fabs(a) + ea
+        t = aa + hi(ea)
         den = (1 - t) * (1 + t)
         return if_else(ea == 0, libm(av), if_else(den > 0, up(ea / ca.sqrt(den) + libm(av)), inf))
     if op in (ca.OP_SINH, ca.OP_COSH):
         return up(ea * ca.cosh(fabs(a) + ea) * (1 + LIBM) + libm(av))
     if op == ca.OP_ATAN2:  # val = atan2(a, b): a = y, b = x
-        s = ea + eb
+        s = hi(ea + eb)
         r = ca.sqrt(a * a + b * b) * (1 - 8 * U)
-        cut = ca.logic_and(b - eb < 0, fabs(a) <= ea)
+        cut = ca.logic_and(b - hi(eb) < 0, aa <= hi(ea))
         return if_else(s == 0, libm(av), if_else(ca.logic_and(r - s > 0, ca.logic_not(cut)),
                                                   up(s / (r - s) + libm(av)), inf))
     if op == ca.OP_CONSTPOW and cb is not None:
-        return _constpow(ca, a, ea, cb, av, up, libm, inf)
+        return _constpow(ca, a, ea, cb, av, up, hi, libm, inf)
     if op == ca.OP_POW:
         if cb is not None:
-            return _constpow(ca, a, ea, cb, av, up, libm, inf)
+            return _constpow(ca, a, ea, cb, av, up, hi, libm, inf)
         return if_else(ca.logic_and(ea == 0, eb == 0), libm(av), inf)
     if op in (ca.OP_FMIN, ca.OP_FMAX):  # Lipschitz 1 in each operand: max(ea, eb) <= ea + eb
         return up(ea + eb)
     if op in (ca.OP_LT, ca.OP_LE, ca.OP_EQ, ca.OP_NE):  # exact where it cannot flip
-        apart = fabs(a - b) * (1 - 4 * U) > ea + eb
+        apart = fabs(a - b) * (1 - 4 * U) > hi(ea + eb)
         return if_else(ca.logic_or(ca.logic_and(ea == 0, eb == 0), apart), zero, inf)
     if op in (ca.OP_NOT,):
         return ea
@@ -225,14 +242,14 @@ def _bound(ca, op, val, a, ea, b, eb, cb, up, libm, zero, inf, aa, ab, av):
     if op == ca.OP_IF_ELSE_ZERO:
         return if_else(ea == 0, if_else(a != 0, eb, zero), inf)
     if op == ca.OP_SIGN:
-        return if_else(ca.logic_or(ea == 0, fabs(a) > ea), zero, inf)
+        return if_else(ca.logic_or(ea == 0, aa > hi(ea)), zero, inf)
     if op in (ca.OP_FLOOR, ca.OP_CEIL, ca.OP_COPYSIGN, ca.OP_FMOD):  # exact on exact operands
         exact = ea == 0 if eb is None else ca.logic_and(ea == 0, eb == 0)
         return if_else(exact, zero, inf)
     return inf  # an operation this module does not bound
 
 
-def _constpow(ca, a, ea, c, av, up, libm, inf):
+def _constpow(ca, a, ea, c, av, up, hi, libm, inf):
     """a^c for a constant c: its derivative's magnitude over the box at its ends."""
     fabs, if_else = ca.fabs, ca.if_else
     if c == 0:
@@ -243,9 +260,9 @@ def _constpow(ca, a, ea, c, av, up, libm, inf):
         d = abs(c) * (fabs(a) + ea) ** (c - 1) * (1 + LIBM)
         return up(d * ea + libm(av))
     if c == math.floor(c):  # a negative integer: |c| (|a| - ea)^(c - 1), the box clear of 0
-        lo = fabs(a) - ea
+        lo = fabs(a) - hi(ea)
         return if_else(lo > 0, up(abs(c) * lo ** (c - 1) * (1 + LIBM) * ea + libm(av)), inf)
-    lo = a - ea  # any other: a positive box, the derivative monotone: both ends summed
+    lo = a - hi(ea)  # any other: a positive box, the derivative monotone: both ends summed
     d = abs(c) * (lo ** (c - 1) + (a + ea) ** (c - 1)) * (1 + LIBM)
     return if_else(ea == 0, libm(av), if_else(lo > 0, up(d * ea + libm(av)), inf))
 

@@ -325,7 +325,7 @@ class Enclosure:
     def __call__(self, *inputs):
         n = max(np.asarray(x).reshape(-1, k).shape[0] if k else 1 for x, k in zip(inputs, self.sizes_in))
         args = [np.ascontiguousarray(np.broadcast_to(np.asarray(x, dtype=float).reshape(-1, k), (n, k)))
-                for x, k in zip(inputs, self.sizes_in)]
+                if k else np.zeros((n, 0)) for x, k in zip(inputs, self.sizes_in)]
         flat = [np.empty((n, r * c)) for r, c in self.shapes_out]
         if self.fn is not None:
             import ctypes

@@ -39,7 +39,8 @@ GHC_SETS = [GHC_POLE[0],
              0.19519644623674662, 3412.590653547689, 0.006089010348727281, 0.00011506680453359225,
              2.4059294406629664e-05, 1.0000000470883692]]
 CASES = {"gyrohorizoncompass": 6, "torsion_gyrocompass": 4, "gimbal_precession": 6,
-         "spherical_pendulum.py": 4, "nonminimal_pendulum.py": 4, "hoop_bead.py": 4}
+         "spherical_pendulum.py": 4, "nonminimal_pendulum.py": 4, "hoop_bead.py": 4,
+         "gyropendulum.py": 3}
 
 
 @pytest.mark.parametrize("name", sorted(CASES))

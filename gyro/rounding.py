@@ -340,13 +340,16 @@ class Enclosure:
             res = self.G.map(n, "serial")(*[a.T for a in args])
             res = res if isinstance(res, tuple) else (res,)
             for o, r, (rows, cols) in zip(flat, res, self.shapes_out):  # (rows, sets * cols)
-                o[:] = np.asarray(r).reshape(rows, n, cols).transpose(1, 2, 0).reshape(n, rows * cols)
-        shaped = [o.reshape(n, c, r).transpose(0, 2, 1) for o, (r, c) in zip(flat, self.shapes_out)]
-        values, bounds = shaped[:self.n_values], shaped[self.n_values:]
-        bounds = [np.where(np.isfinite(b), b, np.inf) for b in bounds]
-        if len(values) == len(bounds):  # each value beside its bound: a value not finite has none
-            bounds = [np.where(np.isfinite(x), b, np.inf) for b, x in zip(bounds, values)]
-        return values, bounds
+                o[:] = np.asarray(r).reshape(rows, n, cols).transpose(1, 0, 2).reshape(n, rows * cols)
+        values, bounds = flat[:self.n_values], flat[self.n_values:]  # row-major: _simd_source
+        with np.errstate(invalid="ignore"):
+            for j, b in enumerate(bounds):  # in place: NaN and a value not finite have no bound
+                b[~(b < np.inf)] = np.inf
+                if len(values) == len(bounds):
+                    b[~np.isfinite(values[j])] = np.inf
+        shape = [(n, r, c) for r, c in self.shapes_out]
+        return ([x.reshape(s) for x, s in zip(values, shape)],
+                [x.reshape(s) for x, s in zip(bounds, shape[self.n_values:])])
 
 
 _CACHE: dict = {}
@@ -449,8 +452,12 @@ def operator_rounding(model, P, qe, M, D, K):
     out = []
     with np.errstate(all="ignore"):
         for X, T, e in zip((M, D, K), twin, bounds):
-            d = (np.abs(np.asarray(X) - T) + e) * GROW
-            out.append(np.where(np.isfinite(d), d, np.inf))
+            d = np.subtract(X, T)  # in place from here: this runs on every set a certificate tries
+            np.abs(d, out=d)
+            d += e
+            d *= GROW
+            d[np.isnan(d)] = np.inf
+            out.append(d)
     return tuple(out)
 
 
@@ -504,10 +511,13 @@ def _simd_source(G, entry: str) -> str:
             nnz = G.nnz_in(i[0])
             lanes = ", ".join(f"in[{i[0]}][s[{q}] * {nnz} + {i[1]}]" for q in range(L))
             expr = f"(vd){{{lanes}}}"
-        elif op == "OP_OUTPUT":
-            nnz = G.nnz_out(o[0])
+        elif op == "OP_OUTPUT":  # a dense output's entries row by row (CasADi's nonzeros go by column)
+            rows, cols = G.size_out(o[0])
+            if G.nnz_out(o[0]) != rows * cols:
+                raise NotImplementedError(f"{G.name()}: a sparse output")
+            at = (o[1] % rows) * cols + o[1] // rows
             body.append(f"    for (int i = 0; i < {L} && k + i < n; ++i) "
-                        f"out[{o[0]}][(k + i) * {nnz} + {o[1]}] = {reg[i[0]]}[i];")
+                        f"out[{o[0]}][(k + i) * {rows * cols} + {at}] = {reg[i[0]]}[i];")
             continue
         elif op == "OP_CONST":
             c = float(G.instruction_constant(k))

@@ -41,8 +41,8 @@ finite gives a bound of +inf (NaN included: `Enclosure` turns it so after the ca
 
 Constants of the graph: a double that is a short dyadic number (an integer or a fraction
 with a power of two below 2^20 as its denominator, as 0.5, 1.5, -2, 4 are) is the model's
-constant exactly; any other (pi/180 as 0.017453292519943295) is taken within 2u of it (one
-rounding of the literal, or two where CasADi folded a product of constants).
+constant exactly; any other (pi/180 as 0.017453292519943295) is taken within 4u of it (one
+rounding of the literal, and up to three where CasADi folded products of constants).
 
 `Enclosure` compiles such a Function (CasADi's code generator -> gyro.cbackend, as
 gyro.ode.compiled does; ISO C99 keeps -ffp-contract=off, so the compiled code performs the
@@ -136,7 +136,7 @@ def enclosure(F, uncertain=None, name: str | None = None, keep=None):
         if op == ca.OP_CONST:
             c = float(F.instruction_constant(k))
             v[o[0]] = ca.SX(c)
-            e[o[0]] = zero if _short_dyadic(c) else ca.SX(2 * U * abs(c))
+            e[o[0]] = zero if _short_dyadic(c) else ca.SX(4 * U * abs(c))
             const[o[0]] = c
             absv.pop(o[0], None)
             continue

@@ -284,12 +284,22 @@ class Enclosure:
     machine by the source's hash, as gyro.ode.compiled), or CasADi's own evaluation without
     a compiler. Call with one array per input (sets, nonzeros), then the radii; returns
     (values, bounds), each a list of (sets, rows, cols) arrays, a bound +inf wherever it (or,
-    where the values are kept, its value) is not finite."""
+    where the values are kept, its value) is not finite.
 
-    def __init__(self, G, n_values: int):  # the first n_values outputs are values, the rest bounds
-        self.G, self.n_values = G, n_values
-        self.sizes_in = [G.nnz_in(i) for i in range(G.n_in())]
-        self.shapes_out = [G.size_out(j) for j in range(G.n_out())]
+    Enclosure(G, n_values): of the enclosure Function G, whose first n_values outputs are
+    values. `enclosed` makes one lazily instead (`spec`): where the C of that Function is
+    already in the cache under its stamp, neither the model's CasADi functions nor the
+    enclosure are built in this process (they take a second or two, every `gyro scene`)."""
+
+    def __init__(self, G=None, n_values: int = 0, spec=None):
+        self._G, self._build = G, None
+        if G is not None:
+            self.label, self.stamp = G.name(), None
+            self.sizes_in = [G.nnz_in(i) for i in range(G.n_in())]
+            self.shapes_out = [G.size_out(j) for j in range(G.n_out())]
+            self.n_values = n_values
+        else:
+            self._build, self.label, self.stamp, self.sizes_in, self.shapes_out, self.n_values = spec
         self.lib = None
         from gyro import cbackend
 
@@ -298,6 +308,12 @@ class Enclosure:
         except (cbackend.CompilerUnavailable, NotImplementedError):  # no compiler, or an operation
             self.fn = None  # _simd_source has no C for: CasADi's own evaluation answers
 
+    @property
+    def G(self):
+        if self._G is None:
+            self._G = self._build()
+        return self._G
+
     def _compile(self):
         import ctypes
         import hashlib
@@ -305,20 +321,24 @@ class Enclosure:
         from gyro import cbackend
 
         cbackend._available()
-        G = self.G
-        text = _simd_source(G, f"{G.name()}_batch")
+        folder = cbackend._writable_cache() / "casadi-sources"
+        stamped = folder / f"{self.label}-{self.stamp}.c" if self.stamp else None
+        if stamped is not None and stamped.exists():
+            text = stamped.read_text()
+        else:
+            text = _simd_source(self.G, f"{self.label}_batch")
         digest = hashlib.sha256(text.encode()).hexdigest()[:16]
-        src = cbackend._writable_cache() / "casadi-sources" / f"{G.name()}-{digest}.c"
+        src = stamped or folder / f"{self.label}-{digest}.c"
         if not src.exists() or src.read_text() != text:
             src.parent.mkdir(parents=True, exist_ok=True)
             tmp = src.with_suffix(f".{os.getpid()}.tmp")
             tmp.write_text(text)
             os.replace(tmp, src)  # atomic: another process may write the same bytes
         # -O1 (gyro.ode.compiled's reason: straight-line code, a compile of seconds)
-        lib = cbackend._shared(f"{G.name()}-{digest}", (src,), (), ("-O1",),
-                               notice=f"the generated C of the rounding enclosure {G.name()}")
+        lib = cbackend._shared(f"{self.label}-{digest}", (src,), (), ("-O1",),
+                               notice=f"the generated C of the rounding enclosure {self.label}")
         self.lib = lib
-        fn = getattr(lib, f"{G.name()}_batch")
+        fn = getattr(lib, f"{self.label}_batch")
         fn.restype = ctypes.c_int
         return fn
 
@@ -335,7 +355,7 @@ class Enclosure:
             outs = (P * len(flat))(*[o.ctypes.data_as(P) for o in flat])
             with np.errstate(all="ignore"):
                 if self.fn(ctypes.c_longlong(n), ins, outs):
-                    raise ArithmeticError(f"{self.G.name()}: the compiled enclosure failed")
+                    raise ArithmeticError(f"{self.label}: the compiled enclosure failed")
         elif n:
             res = self.G.map(n, "serial")(*[a.T for a in args])
             res = res if isinstance(res, tuple) else (res,)
@@ -359,17 +379,39 @@ _LOCK = threading.Lock()
 def enclosed(model, fname: str, uncertain=("qe",), keep=None) -> Enclosure:
     """The Enclosure of a model's generated function `fname` (its CasADi twin, model.casadi),
     radii on the inputs `uncertain` (those it has), the outputs `keep` (enclosure's): cached
-    per model, function and choice."""
+    per model, function and choice; its C found in the machine's cache by a stamp of the
+    model's generated inputs (metadata's input_hash), the choice, this module's source and
+    CasADi's version, without building anything where it is there."""
     key = (model.name, str(getattr(model, "directory", "")), fname, tuple(uncertain), keep and tuple(keep))
     with _LOCK:
         if key not in _CACHE:
-            F = getattr(model.casadi, fname)
-            has = [nm for nm in uncertain if nm in [F.name_in(i) for i in range(F.n_in())]]
-            outs = [F.name_out(j) for j in range(F.n_out())] if keep is None else list(keep)
-            tag = "" if keep is None and list(has) == ["qe"] else "_" + "_".join(has + ["to"] + outs)
+            meta = model.meta["functions"][fname]
+            ins = [(i["name"], len(i["symbols"])) for i in meta["inputs"]]
+            outs_meta = {o["name"]: o for o in meta["outputs"]}
+            has = [nm for nm in uncertain if nm in dict(ins)]
+            names = [o["name"] for o in meta["outputs"]]
+            outs = names + ["e_" + nm for nm in names] if keep is None else list(keep)
+            tag = "" if keep is None and has == ["qe"] else "_" + "_".join(has + ["to"] + list(keep or names))
             label = re.sub(r"\W", "_", f"gyro_enclosure_{model.name}_{fname}{tag}")
-            G = enclosure(F, has, label, keep)
-            _CACHE[key] = Enclosure(G, sum(not nm.startswith("e_") for nm in outs))
+            n_values = sum(not nm.startswith("e_") for nm in outs)
+
+            def build():
+                return enclosure(getattr(model.casadi, fname), has, label, keep)
+
+            made = model.meta.get("generated", {}).get("input_hash")
+            plain = all("nonzeros" not in outs_meta[nm.removeprefix("e_")] for nm in outs)
+            if made and plain:
+                import hashlib
+
+                import casadi as ca
+
+                h = hashlib.sha256(repr((made, model.name, fname, has, outs, LANES, ca.__version__)).encode())
+                h.update(open(__file__, "rb").read())
+                sizes = [k for _, k in ins] + [dict(ins)[nm] for nm in has]
+                shapes = [tuple(outs_meta[nm.removeprefix("e_")]["shape"]) for nm in outs]
+                _CACHE[key] = Enclosure(spec=(build, label, h.hexdigest()[:16], sizes, shapes, n_values))
+            else:
+                _CACHE[key] = Enclosure(build(), n_values)
         return _CACHE[key]
 
 
@@ -397,8 +439,7 @@ def equilibrium_radius(model, P, qe) -> np.ndarray:
         return out
     if "equilibrium_system" not in model.meta["functions"]:
         return out  # generated before the Newton system was emitted: nothing proven
-    F = model.casadi.equilibrium_system
-    r_name, k_name = F.name_out(0), F.name_out(1)
+    r_name, k_name = (o["name"] for o in model.meta["functions"]["equilibrium_system"]["outputs"])
     # at qe: the residual, Kn and the residual's bound (qe exact); over a box: Kn's bound alone
     point = enclosed(model, "equilibrium_system", (), (r_name, k_name, "e_" + r_name))
     box = enclosed(model, "equilibrium_system", ("qe",), ("e_" + k_name,))

@@ -300,13 +300,23 @@ class Enclosure:
             self.n_values = n_values
         else:
             self._build, self.label, self.stamp, self.sizes_in, self.shapes_out, self.n_values = spec
-        self.lib = None
+        self.lib = self.fn = None
+        self._tried = False  # compiled on first use outside gyro.cbackend.disabled()
+
+    def _compiled(self):
+        """The compiled entry point, or None (no compiler, an operation _simd_source has no C
+        for, or within gyro.cbackend.disabled(): CasADi's own evaluation answers)."""
         from gyro import cbackend
 
-        try:
-            self.fn = self._compile()
-        except (cbackend.CompilerUnavailable, NotImplementedError):  # no compiler, or an operation
-            self.fn = None  # _simd_source has no C for: CasADi's own evaluation answers
+        if cbackend._disabled:
+            return None
+        if not self._tried:
+            self._tried = True
+            try:
+                self.fn = self._compile()
+            except (cbackend.CompilerUnavailable, NotImplementedError):
+                self.fn = None
+        return self.fn
 
     @property
     def G(self):
@@ -347,14 +357,15 @@ class Enclosure:
         args = [np.ascontiguousarray(np.broadcast_to(np.asarray(x, dtype=float).reshape(-1, k), (n, k)))
                 if k else np.zeros((n, 0)) for x, k in zip(inputs, self.sizes_in)]
         flat = [np.empty((n, r * c)) for r, c in self.shapes_out]
-        if self.fn is not None:
+        fn = self._compiled()
+        if fn is not None:
             import ctypes
 
             P = ctypes.POINTER(ctypes.c_double)
             ins = (P * len(args))(*[a.ctypes.data_as(P) for a in args])
             outs = (P * len(flat))(*[o.ctypes.data_as(P) for o in flat])
             with np.errstate(all="ignore"):
-                if self.fn(ctypes.c_longlong(n), ins, outs):
+                if fn(ctypes.c_longlong(n), ins, outs):
                     raise ArithmeticError(f"{self.label}: the compiled enclosure failed")
         elif n:
             res = self.G.map(n, "serial")(*[a.T for a in args])

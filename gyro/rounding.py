@@ -44,10 +44,12 @@ with a power of two below 2^20 as its denominator, as 0.5, 1.5, -2, 4 are) is th
 constant exactly; any other (pi/180 as 0.017453292519943295) is taken within 4u of it (one
 rounding of the literal, and up to three where CasADi folded products of constants).
 
-`Enclosure` compiles such a Function (CasADi's code generator -> gyro.cbackend, as
-gyro.ode.compiled does; ISO C99 keeps -ffp-contract=off, so the compiled code performs the
-operations the bound was derived for) with a loop over a batch, and falls back on CasADi's
-own evaluation without a compiler. `operator_rounding` is what the runtime uses: the
+`Enclosure` compiles such a Function into C through gyro.cbackend, as gyro.ode.compiled
+does, but by an emitter of its own (`_simd_source`: one statement per instruction, four sets
+a vector, since CasADi's generated code keeps every value in a work array and ran 12x
+slower on the gyrohorizoncompass's operator); ISO C99 keeps -ffp-contract=off, so the
+compiled code performs the operations the bound was derived for, to the bit those of
+CasADi's own evaluation, which answers without a compiler. `operator_rounding` is what the runtime uses: the
 operator's rounding, the equilibrium's and the difference to the operator actually used.
 """
 from __future__ import annotations

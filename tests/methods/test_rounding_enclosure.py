@@ -96,7 +96,7 @@ def test_the_probes_miss_an_entry_the_enclosure_holds():
     (0.05x..20x of the gyrohorizoncompass, found among 200 random ones: one in six of them
     has such an entry) neither moves K[3, 3] = 8.6e-4 at all, while the double entry is off
     the exact one by 1.1e-20: an estimate of 0 for a rounding that is there. The
-    enclosure holds it (2.9e-18)."""
+    enclosure holds it (5.8e-18)."""
     m = load("gyrohorizoncompass")
     P = np.array([[0.006144811344599689, 0.005832742863354314, 0.005755671116476416, 0.00359795110641016,
                    2.055250858699009, 87783.10221641204, 0.02415750979850754, 0.0002105457556632642,

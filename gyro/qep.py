@@ -350,9 +350,12 @@ INPUT_MOVE = 4 * EPS  # each parameter moved by this, relative (as input_roundin
 
 
 def equilibrium_moves(model: Model, P, qe, M, D, K):
-    """The double operator's own rounding, entrywise in absolute value, beyond what an
-    estimate of the eigenproblem at the given M, D, K sees: the largest change of M, D, K
-    over two fixed perturbations, each moving every equilibrium coordinate by EQ_MOVE and
+    """An estimate (not a bound) of the double operator's own rounding, entrywise in absolute
+    value, beyond what an estimate of the eigenproblem at the given M, D, K sees, for the
+    double methods' estimates (the certificate's count takes an enclosure instead:
+    gyro.rounding.operator_rounding; two probes in fixed directions miss an entry whose
+    rounding they do not move, tests/methods/test_rounding_enclosure.py): the largest
+    change of M, D, K over two fixed perturbations, each moving every equilibrium coordinate by EQ_MOVE and
     every parameter by INPUT_MOVE relative, with signs alternating in runs of 1 and of 2
     (one pattern alone leaves a product or a ratio of two inputs unmoved).
     - The equilibrium's rounding: large where the operator turns a coordinate's absolute

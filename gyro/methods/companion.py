@@ -26,7 +26,7 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None) -> Spectrum:
     est = np.full((P.shape[0], n), np.inf)
     if ok.any():
         lam[ok], est[ok] = qep.companion_roots(M[ok], D[ok], K[ok])
-        # the equilibrium's own rounding (gyro.qep.equilibrium_moves)
+        # the operator's own rounding, estimated (gyro.qep.equilibrium_moves: two probes)
         moves = qep.equilibrium_moves(model, P[ok], qe[ok], M[ok], D[ok], K[ok])
         est[ok] += qep.general_moves(moves, M[ok], D[ok], K[ok], lam[ok])
     f, g, e = qep.sort_spectrum(np.abs(lam.imag), lam.real, est)

@@ -62,7 +62,8 @@ def solve(model: Model, P: np.ndarray, tol: float | None = None) -> Spectrum:
             e = 0.5 * ds / np.maximum(np.abs(roots_s), 1e-300)
         freq[k], growth[k] = np.abs(lam.imag), lam.real
         est[k] = np.where(e < 0.5, e, np.inf)  # a first-order bound past 1/2 bounds nothing
-    # the equilibrium's own rounding (gyro.qep.equilibrium_moves), where a root was found
+    # the operator's own rounding, estimated (gyro.qep.equilibrium_moves: two probes), where a
+    # root was found
     done = np.flatnonzero(ok & np.any(np.isfinite(est), axis=1))
     if done.size:
         moves = qep.equilibrium_moves(model, P[done], qe[done], M[done], D[done], K[done])

@@ -290,7 +290,7 @@ def counts_below(M, D, K, w, moves=None) -> np.ndarray:
     eps of their magnitude |K| + w^2 |M| + w |D| of the operator's (its forming and the
     evaluation of the operator); a count is proven where no eigenvalue is within the sum
     of the two of zero (Weyl). With `moves` (dM, dD, dK: the operator's own rounding,
-    gyro.qep.equilibrium_moves) the exact operator's matrix is within
+    enclosed by gyro.rounding.operator_rounding) the exact operator's matrix is within
     |dK| + w^2 |dM| + w |dD| of the one formed, and its scaled Frobenius norm joins the sum."""
     n = M.shape[-1]
     w = np.asarray(w, dtype=float)[:, None, None]
@@ -424,8 +424,10 @@ class Exact:
 
 def _exact(model, P):
     """(ok, M, D, K of the sets with an equilibrium, their operator's own rounding dM, dD, dK
-    (gyro.qep.equilibrium_moves), their counts at 0) over the batch P."""
-    from gyro import qep
+    (gyro.rounding.operator_rounding: an enclosure of the distance of M, D, K from the exact
+    operator at the exact equilibrium, the equilibrium's own error included), their counts
+    at 0) over the batch P."""
+    from gyro import rounding
     from gyro.equilibrium import equilibria, operators
 
     qe, ok = equilibria(model, P)
@@ -437,7 +439,7 @@ def _exact(model, P):
     Pk, qk = (P, qe) if every else (P[ok], qe[ok])
     M, D, K = operators(model, Pk, qk)
     M, D, K = (np.ascontiguousarray(X, dtype=float) for X in (M, D, K))
-    moves = qep.equilibrium_moves(model, Pk, qk, M, D, K)
+    moves = rounding.operator_rounding(model, Pk, qk, M, D, K)
     zero = counts_at(M, D, K, np.zeros((M.shape[0], 1)), moves=moves)[:, 0]
     return (ok, M, D, K, *moves, zero)
 

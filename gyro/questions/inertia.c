@@ -17,8 +17,8 @@
  * count_one, by ||L^-1||_F ||B^-1 L^-1||_F before the product is formed (separation_bound:
  * the product's n^3 only where that does not decide). Each bounds ||(L B L^H)^-1||_2 from
  * above, as the product's norm does, so each proves the signs by the same Weyl argument.
- * With dM, dD, dK (entrywise changes of M, D, K: the operator's own rounding,
- * gyro.qep.equilibrium_moves; NULL: none), the exact operator differs from the one given by
+ * With dM, dD, dK (entrywise bounds of M, D, K's distance from the exact operator, its own
+ * rounding and the equilibrium's: gyro.rounding.operator_rounding; NULL: none), the exact operator differs from the one given by
  * at most E_op, |E_op| <= |dK| + w^2 |dM| + w |dD|, whose scaled Frobenius norm joins the
  * perturbations.
  * M, D, K are (sets, n, n) row-major, set b's the row rows[b] (b where rows is NULL), w (N, P),
@@ -54,7 +54,7 @@ static double separation_bound(long n, double xF, double zF)
 }
 
 /* The scaled sum of squares of the operator's own rounding, |dK| + w^2 |dM| + w |dD| (the
- * entrywise changes of gyro.qep.equilibrium_moves) times s_i s_j: a loop of its own, so that
+ * entrywise bounds of gyro.rounding.operator_rounding) times s_i s_j: a loop of its own, so that
  * the counts' loops stay as the compiler vectorises them where there is none */
 static double op_rounding(long n, const double *s, const double *dM, const double *dD, const double *dK, double w)
 {

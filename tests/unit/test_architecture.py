@@ -94,7 +94,7 @@ def test_the_cycle_finder_finds_one():
 
 def test_the_flow_runs_one_way():
     g = import_graph()
-    layer = {"gyro.cli": 5, "gyro.analyses": 4, "gyro.systems": 4, "gyro.questions": 4, "gyro.ladder": 3, "gyro.levels": 3, "gyro.methods": 2, "gyro.qep": 1,
+    layer = {"gyro.cli": 5, "gyro.analyses": 4, "gyro.systems": 4, "gyro.questions": 4, "gyro.ladder": 3, "gyro.levels": 3, "gyro.methods": 2, "gyro.qep": 1, "gyro.rounding": 1,
              "gyro.equilibrium": 1, "gyro.kernels": 1, "gyro.executor": 1, "gyro.ode": 1, "gyro.results": 1, "gyro.cbackend": 0, "gyro.models": 0}
 
     def level(m):

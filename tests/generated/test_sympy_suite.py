@@ -17,7 +17,6 @@ import sympy as sp
 
 from derive import pipeline
 from derive.model import Unsupported
-from tests.generated.test_speeds import _plain
 from tests.generated.test_textbook import MODELS
 
 SUITE = MODELS / "sympy_suite"
@@ -40,6 +39,18 @@ def _derive(module, builder="build"):
     one = SimpleNamespace(build=getattr(module, builder), __file__=module.__file__, __name__=module.__name__,
                           __derive_folder__=module.__derive_folder__)
     return pipeline.derive(build(one), pipeline.Steps(out=io.StringIO()))
+
+
+def _plain(X):
+    """X of SymPy's method in the machinery's symbols: f(t) -> f, f' -> f_d, f'' -> f_dd,
+    symbols without their assumptions."""
+    from sympy.core.function import AppliedUndef
+
+    X = sp.Matrix(X)
+    X = X.xreplace({d: sp.Symbol(f"{d.expr.func.__name__}_{'d' * d.derivative_count}")
+                    for d in X.atoms(sp.Derivative)})
+    X = X.xreplace({f: sp.Symbol(f.func.__name__) for f in X.atoms(AppliedUndef)})
+    return X.xreplace({s: sp.Symbol(s.name) for s in X.free_symbols})
 
 
 def _at(X, pt):
@@ -99,3 +110,34 @@ def test_sympys_two_methods_disagree_on_the_rolling_disc():
     lagrange = [sp.N(e.xreplace(pt), 30) for e in lm.rhs()[3:]]
     assert abs(kane[1] - lagrange[1]) < 1e-25
     assert abs(kane[0] - lagrange[0]) > 0.1 and abs(kane[2] - lagrange[2]) > 0.1
+
+
+# --------------------------------------------------------------------------- agreement
+
+
+def _lagrange_residual(d, lm):
+    """(ours, LagrangesMethod's) equations of motion as residuals in q'' and the
+    multipliers: the first n rows of mass_matrix [q''; lam] - forcing, and lm.eom with its
+    multipliers named as ours."""
+    n, m = len(lm.q), len(lm.lam_vec)
+    lam = sp.symbols(f"lam1:{m + 1}")
+    ours = (d.mass_matrix * sp.Matrix(list(d.model.qdd) + list(lam)) - d.forcing)[:n, :]
+    return ours, _plain(lm.eom.xreplace(dict(zip(lm.lam_vec, lam))) if m else lm.eom)
+
+
+@pytest.mark.parametrize("name", ["link_cart", "joints_cart", "arm_on_line", "rotating_rod"])
+def test_equations_are_sympys_own(name):
+    """models.n_link_pendulum_on_cart(2) with its joint torques and a cart on joints with a
+    LinearSpring, a LinearDamper and a TorqueActuator (Kane's form: KanesMethod's / System's
+    mass matrix and forcing in the speeds), a two-link arm held by one configuration
+    constraint that no linear solve finds (one multiplier: LagrangesMethod's eom), a bead on
+    a rod turning at w t (explicit time: LagrangesMethod's eom)."""
+    module = _module(name)
+    d = _derive(module)
+    kind, method = module.reference()
+    if kind == "kane":
+        assert_same(d.speeds["mass_matrix"], _plain(method.mass_matrix))
+        assert_same(d.speeds["forcing"], _plain(method.forcing))
+    else:
+        assert d.route == ("multipliers" if method.lam_vec else "coordinates")
+        assert_same(*_lagrange_residual(d, method))

@@ -7,7 +7,9 @@ coordinates, their rates and accelerations, with no assumptions.
   name). `qd` and `qdd` may be left empty, or given as speeds `dynamicsymbols('u')`. With
   kinematic equations (`kinematics`, KanesMethod's kd_eqs) a speed is what they say: every
   u is replaced by its expression in q and q', and the record of q' = V u + v goes to the
-  derivation, which forms the equations in the speeds (derive/passes/speeds.py). Without
+  derivation, which forms the equations in the speeds (derive/passes/speeds.py); with
+  holonomic constraints only kinematic equations u_i = q_i' (a joint's) are taken, the
+  speeds then being the rates. Without
   them a speed stands for its coordinate's derivative, and must be it in every velocity of
   the model's frames and points it enters; a speed that is not, or that enters none
   the machinery can see, is refused (_check_velocities), never guessed. Every velocity
@@ -182,6 +184,13 @@ def _kinematics(model: Model):
     solve_u = -Wu.LUsolve(Wq * sp.Matrix(qdots) + rest)
     V, v = -Wq.LUsolve(Wu), -Wq.LUsolve(rest)
     return us, dict(zip(us, solve_u)), V, v
+
+
+def _rates_themselves(kin) -> bool:
+    """The kinematic equations say u_i = q_i' for each i, in order (q' = V u + v with V the
+    identity and v zero), as the kdes of sympy's joints do."""
+    V, v = kin[2], kin[3]
+    return all(sp.expand(e) == 0 for e in list(V - sp.eye(V.rows)) + list(v))
 
 
 def _numerically_zero(exprs, rng) -> bool:
@@ -432,6 +441,10 @@ def _convert(model: Model) -> Model:
     loads = [ld if isinstance(ld, Load) and not (_is_vector(ld.vector) or _is_vector(ld.velocity))
              else _load(ld, model.frame, f"{model.name}: load {k + 1}") for k, ld in enumerate(model.loads)]
     kin = _kinematics(model)
+    if kin and model.holonomic and _rates_themselves(kin):
+        # u_i = q_i' (a joint's kdes): the speeds are the rates, claimed and checked as such, and
+        # the constraints take the route of a model in rates (speeds with constraints are not derived)
+        model, kin = dataclasses.replace(model, kinematics=[]), None
     mapping, q, qd, qdd, claimed = _dynamic_rates(dataclasses.replace(model, qd=[], qdd=[]) if kin else model)
     if claimed or model.frame is not None:
         _check_velocities(model, claimed, kin)

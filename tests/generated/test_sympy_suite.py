@@ -141,3 +141,54 @@ def test_equations_are_sympys_own(name):
     else:
         assert d.route == ("multipliers" if method.lam_vec else "coordinates")
         assert_same(*_lagrange_residual(d, method))
+
+
+# --------------------------------------------------------------------------- closed chain on joints
+
+
+def test_a_four_bar_on_joints_derives_in_seconds_as_systems_linearisation():
+    """test_jointsmethod's four-bar with System: three PinJoints (relative angles, speeds with
+    the joints' kdes u - q' = 0), two loop constraints, gravity, a spring actuator on joint 1.
+    Refused before (kinematic equations beside holonomic constraints): the kdes say the speeds
+    are the rates, so they are taken as such; and its operator's parts (a K of 7,370
+    operations) are no longer expanded (85 s). At the loop's equilibrium near the one gyro
+    finds (q = (-1.958, 1.915, 2.437)), our M and K in q1 are Kane's reduced equations' (its
+    dynamic row of the mass matrix times dq/dq1 on the loop, and -d forcing/d q1 along the
+    loop, each derivative a central difference of step 1e-12 at 50 digits: error 1e-24), to
+    1e-15."""
+    module = _module("four_bar_joints")
+    d = _derive(module)
+    assert d.route == "multipliers" and d.constraints["independent"] == ["q1"]
+    parts = dict(next(f for f in pipeline.functions(d) if f.name == "operator_parts").outputs)
+    assert parts["Ks"][0] == d.operator.K[0]  # as it comes: K_s = (K + K')/2 = K, not expanded
+    _, km = module.reference()
+    from sympy.physics.mechanics import dynamicsymbols
+
+    t = dynamicsymbols._t
+    par = {sp.Symbol(p.name): sp.Rational(str(p.default)) for p in d.model.parameters}
+    qs = sp.symbols("q1:4")
+    zero_u = {u: 0 for u in km.u} | {x.diff(t): 0 for x in km.q}
+    plain = dict(zip(km.q, qs))
+    f = sp.Matrix(km.forcing).xreplace(zero_u).xreplace(plain)
+    f = f.xreplace({s: par[sp.Symbol(s.name)] for s in f.free_symbols if sp.Symbol(s.name) in par})
+    M = sp.Matrix(km.mass_matrix).xreplace(plain)
+    M = M.xreplace({s: par[sp.Symbol(s.name)] for s in M.free_symbols if sp.Symbol(s.name) in par})
+    phi = [sp.sympify(c).xreplace(par) for c in d.constraints["holonomic"]]
+    with mpmath.workdps(50):
+        F = sp.lambdify(qs, [f[0]] + phi, "mpmath")
+        qe = list(mpmath.findroot(lambda *q: F(*q), (-1.958, 1.915, 2.437)))
+        loop = sp.lambdify(qs, phi, "mpmath")
+        force = sp.lambdify(qs, f[0], "mpmath")
+
+        def on_loop(q1):
+            return [q1] + list(mpmath.findroot(lambda a, b: loop(q1, a, b), qe[1:]))
+
+        h = mpmath.mpf("1e-12")
+        K_kane = -(force(*on_loop(qe[0] + h)) - force(*on_loop(qe[0] - h))) / (2 * h)
+        # Kane's dynamic row in all three u', the dependent ones C u1' on the loop
+        C = [(a - b) / (2 * h) for a, b in zip(on_loop(qe[0] + h), on_loop(qe[0] - h))]
+        M_kane = sum(m * c for m, c in zip(sp.lambdify(qs, list(M[0, :]), "mpmath")(*qe), C))
+        at = dict(zip(qs, [sp.Float(x, 50) for x in qe])) | par
+        M_ours, K_ours = (sp.N(X[0].xreplace(at), 50) for X in (d.operator.M, d.operator.K))
+        assert abs(M_ours - M_kane) <= 1e-15 * abs(M_kane)
+        assert abs(K_ours - K_kane) <= 1e-15 * abs(K_kane)

@@ -195,17 +195,23 @@ def _rates_themselves(kin) -> bool:
 
 def _numerically_zero(exprs, rng) -> bool:
     """Every expression (in functions of time, their derivatives and symbols) zero at two
-    random rational points, to 30 digits."""
+    random rational points, to 30 digits: each value a 30-digit Float, so that every
+    subexpression is evaluated as the values go in (evalf of the exact rationals' tree took
+    4 s of a heavy top's conversion)."""
     exprs = [sp.sympify(e) for e in exprs]
+
+    def value(lo, hi):
+        return sp.Float(sp.Rational(rng.randint(lo, hi), 1000), 30)
+
     for _ in range(2):
         pt = {}
         for e in exprs:
             for d in e.atoms(sp.Derivative):
-                pt.setdefault(d, sp.Rational(rng.randint(-2000, 2000), 1000))
+                pt.setdefault(d, value(-2000, 2000))
         sub = [e.xreplace(pt) for e in exprs]
-        pt2 = {f: sp.Rational(rng.randint(-2000, 2000), 1000) for e in sub for f in e.atoms(AppliedUndef)}
+        pt2 = {f: value(-2000, 2000) for e in sub for f in e.atoms(AppliedUndef)}
         sub = [e.xreplace(pt2) for e in sub]
-        pt3 = {s: sp.Rational(rng.randint(500, 2000), 1000) for e in sub for s in e.free_symbols}
+        pt3 = {s: value(500, 2000) for e in sub for s in e.free_symbols}
         if any(abs(complex(sp.N(e.xreplace(pt3), 30))) > 1e-20 for e in sub):
             return False
     return True
@@ -259,6 +265,15 @@ def _frames_and_points(model: Model):
     return frames, points
 
 
+def _w_of_dcm(f, other):
+    """The angular velocity of f in other that f's orientation gives, in f's components
+    (w x = C C'^T in f, C = f.dcm(other)), as it comes: sympy's own (_w_diff_dcm)
+    trigsimps each component, 4 s of a heavy top's 4.6 s conversion."""
+    C = f.dcm(other)
+    Cd = C.applyfunc(lambda e: e.diff(TIME))
+    return C.row(2).dot(Cd.row(1)) * f.x + C.row(0).dot(Cd.row(2)) * f.y + C.row(1).dot(Cd.row(0)) * f.z
+
+
 def _check_velocities(model: Model, claimed: list, kin) -> None:
     """Every velocity the model's frames and points set, held to the one their orientation
     or position gives: a set angular velocity against the one its orientation gives, a set
@@ -289,7 +304,7 @@ def _check_velocities(model: Model, claimed: list, kin) -> None:
     for f in frames:
         for other, w in getattr(f, "_ang_vel_dict", {}).items():
             if other in getattr(f, "_dcm_dict", {}) and f is not model.frame:  # each pair from its body's side
-                checks.append((w, lambda f=f, other=other: f._w_diff_dcm(other), other,
+                checks.append((w, lambda f=f, other=other: _w_of_dcm(f, other), other,
                                f"the angular velocity of {f} in {other}", "its orientation gives"))
     inertial = model.frame
     for p in points:

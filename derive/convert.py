@@ -274,12 +274,17 @@ def _w_of_dcm(f, other):
     return C.row(2).dot(Cd.row(1)) * f.x + C.row(0).dot(Cd.row(2)) * f.y + C.row(1).dot(Cd.row(0)) * f.z
 
 
+ORIENTATION = "its orientation gives"
+
+
 def _check_velocities(model: Model, claimed: list, kin) -> None:
-    """Every velocity the model's frames and points set, held to the one their orientation
-    or position gives: a set angular velocity against the one its orientation gives, a set
-    velocity against its neighbour's plus the time derivative of the position between them,
-    with each speed what it is (its expression in q and q' where kinematic equations say,
-    else the rate of its coordinate). At two random points, to 30 digits.
+    """Every velocity the model's points set, and every angular velocity its frames set in
+    speeds, held to the one their position or orientation gives: a set velocity against its
+    neighbour's plus the time derivative of the position between them (each pair once), a
+    set angular velocity against the one its orientation gives (one in q' alone is the one
+    sympy's orientation set), with each speed what it is (its expression in q and q' where
+    kinematic equations say, else the rate of its coordinate). At two random points, to 30
+    digits.
 
     A mismatch where a speed given without kinematic equations (u(t) in `qd` for q(t))
     enters is that speed not being its coordinate's rate: refused in one line, kinematic
@@ -305,17 +310,22 @@ def _check_velocities(model: Model, claimed: list, kin) -> None:
         for other, w in getattr(f, "_ang_vel_dict", {}).items():
             if other in getattr(f, "_dcm_dict", {}) and f is not model.frame:  # each pair from its body's side
                 checks.append((w, lambda f=f, other=other: _w_of_dcm(f, other), other,
-                               f"the angular velocity of {f} in {other}", "its orientation gives"))
+                               f"the angular velocity of {f} in {other}", ORIENTATION))
     inertial = model.frame
+    pairs = set()
     for p in points:
         vp = getattr(p, "_vel_dict", {}).get(inertial)
         for o, r in getattr(p, "_pos_dict", {}).items():
             vo = getattr(o, "_vel_dict", {}).get(inertial)
-            if vp is not None and vo is not None:
+            if vp is not None and vo is not None and (id(o), id(p)) not in pairs:  # each pair once
+                pairs.add((id(p), id(o)))
                 checks.append((vp, lambda vo=vo, r=r: vo + r.dt(inertial), inertial,
                                f"the velocity of {p} in {inertial}", f"its position from {o} gives"))
+    given = list(sub)
     for w, implied, frame, what, gives in checks:
         inside = [u for u in as_rate if w.args and any(m.has(u) for m, _ in w.args)]
+        if gives == ORIENTATION and not (given and w.args and any(m.has(*given) for m, _ in w.args)):
+            continue  # an angular velocity in q' alone: the one its orientation set (sympy's orient)
         try:
             diff = (w.xreplace(sub) - implied().xreplace(sub)).to_matrix(frame)
         except Exception:  # frames not oriented to each other: nothing to hold it to

@@ -61,6 +61,11 @@ def kanes_method():
     return km
 
 
+def reference():
+    """SymPy's method on the system as build() gives it."""
+    return "kane", kanes_method()
+
+
 def lagranges_method():
     L, q, _, N = system_lagrange()
     lm = LagrangesMethod(L, q, frame=N)

@@ -192,3 +192,25 @@ def test_a_four_bar_on_joints_derives_in_seconds_as_systems_linearisation():
         M_ours, K_ours = (sp.N(X[0].xreplace(at), 50) for X in (d.operator.M, d.operator.K))
         assert abs(M_ours - M_kane) <= 1e-15 * abs(M_kane)
         assert abs(K_ours - K_kane) <= 1e-15 * abs(K_kane)
+
+
+@pytest.mark.parametrize("name, at", [("link_cart", {}), ("joints_cart", {"q1": sp.Rational(1, 5)})])
+def test_input_matrix_is_linearizes_B(name, at):
+    """The cart's force and the joint torques (models.n_link_pendulum_on_cart's F, T1, T2; the
+    TorqueActuator's T): M^-1 B of ours at the equilibrium (q = 0; q1 = x0 = 1/5, q2 = 0) is
+    the lower block of KanesMethod's linearize() B there, exactly (rational parameters)."""
+    from sympy.physics.mechanics import dynamicsymbols
+
+    module = _module(name)
+    d = _derive(module)
+    _, km = module.reference()
+    t = dynamicsymbols._t
+    par = {sp.Symbol(p.name): sp.Rational(str(p.default)) for p in d.model.parameters}
+    op = {x: at.get(x.func.__name__, 0) for x in km.q} | {x.diff(t): 0 for x in km.q}
+    op |= {u: 0 for u in km.u} | {u.diff(t): 0 for u in km.u}
+    _, B, r = km.linearize(A_and_B=True, op_point=op)
+    B = B.xreplace({s: par[sp.Symbol(s.name)] for s in B.free_symbols})
+    where = {q: at.get(str(q), 0) for q in d.rq} | par
+    ours = d.operator.M.xreplace(where).inv() * d.input_matrix.xreplace(where)
+    theirs = B[len(km.q):, [[str(x.func) for x in r].index(str(s)) for s in d.inputs]]
+    assert sp.simplify(ours - theirs) == sp.zeros(*ours.shape)

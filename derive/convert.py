@@ -277,7 +277,7 @@ def _w_of_dcm(f, other):
 ORIENTATION = "its orientation gives"
 
 
-def _check_velocities(model: Model, claimed: list, kin) -> None:
+def _check_velocities(model: Model, claimed: list, kin, as_kdes: bool = False) -> None:
     """Every velocity the model's points set, and every angular velocity its frames set in
     speeds, held to the one their position or orientation gives: a set velocity against its
     neighbour's plus the time derivative of the position between them (each pair once), a
@@ -304,13 +304,16 @@ def _check_velocities(model: Model, claimed: list, kin) -> None:
     seen: set = set()
     fix = ("give the kinematic equations (kinematics=[q' - u, ...] or the body's, as KanesMethod's "
            "kd_eqs), or write the coordinate's derivative itself")
+    if as_kdes:  # kinematic equations u = q' beside holonomic constraints: rates, to be shown as such
+        fix = ("beside holonomic constraints, speeds are taken as their coordinates' rates (kinematic "
+               "equations u = q'), and must be shown to be them in the model's frame")
     frames, points = _frames_and_points(model)
     checks = []
     for f in frames:
         for other, w in getattr(f, "_ang_vel_dict", {}).items():
             if other in getattr(f, "_dcm_dict", {}) and f is not model.frame:  # each pair from its body's side
                 checks.append((w, lambda f=f, other=other: _w_of_dcm(f, other), other,
-                               f"the angular velocity of {f} in {other}", ORIENTATION))
+                               f"the angular velocity of {f} in {other}", ORIENTATION, (w,)))
     inertial = model.frame
     pairs = set()
     for p in points:
@@ -320,10 +323,10 @@ def _check_velocities(model: Model, claimed: list, kin) -> None:
             if vp is not None and vo is not None and (id(o), id(p)) not in pairs:  # each pair once
                 pairs.add((id(p), id(o)))
                 checks.append((vp, lambda vo=vo, r=r: vo + r.dt(inertial), inertial,
-                               f"the velocity of {p} in {inertial}", f"its position from {o} gives"))
+                               f"the velocity of {p} in {inertial}", f"its position from {o} gives", (vp, vo)))
     given = list(sub)
-    for w, implied, frame, what, gives in checks:
-        inside = [u for u in as_rate if w.args and any(m.has(u) for m, _ in w.args)]
+    for w, implied, frame, what, gives, entered in checks:  # a speed in either velocity of a pair is checked
+        inside = [u for u in as_rate if any(v.args and any(m.has(u) for m, _ in v.args) for v in entered)]
         if gives == ORIENTATION and not (given and w.args and any(m.has(*given) for m, _ in w.args)):
             continue  # an angular velocity in q' alone: the one its orientation set (sympy's orient)
         try:
@@ -466,13 +469,14 @@ def _convert(model: Model) -> Model:
     loads = [ld if isinstance(ld, Load) and not (_is_vector(ld.vector) or _is_vector(ld.velocity))
              else _load(ld, model.frame, f"{model.name}: load {k + 1}") for k, ld in enumerate(model.loads)]
     kin = _kinematics(model)
-    if kin and model.holonomic and _rates_themselves(kin):
+    as_kdes = bool(kin and model.holonomic and _rates_themselves(kin))
+    if as_kdes:
         # u_i = q_i' (a joint's kdes): the speeds are the rates, claimed and checked as such, and
         # the constraints take the route of a model in rates (speeds with constraints are not derived)
         model, kin = dataclasses.replace(model, kinematics=[]), None
     mapping, q, qd, qdd, claimed = _dynamic_rates(dataclasses.replace(model, qd=[], qdd=[]) if kin else model)
     if claimed or model.frame is not None:
-        _check_velocities(model, claimed, kin)
+        _check_velocities(model, claimed, kin, as_kdes)
     # with kinematic equations, each speed u(t) is its expression in q and q' everywhere
     speed_sub = {}
     if kin:

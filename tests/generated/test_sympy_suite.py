@@ -214,3 +214,23 @@ def test_input_matrix_is_linearizes_B(name, at):
     ours = d.operator.M.xreplace(where).inv() * d.input_matrix.xreplace(where)
     theirs = B[len(km.q):, [[str(x.func) for x in r].index(str(s)) for s in d.inputs]]
     assert sp.simplify(ours - theirs) == sp.zeros(*ours.shape)
+
+
+def test_the_nonminimal_pendulum_in_kanes_form_is_linearizes():
+    """test_linearize_pendulum_kane_nonminimal as written there (speeds u = q' by kde, the
+    constraint |P| - L = 0, g = 9.8): the speeds are the rates beside the constraint, checked
+    where they enter (P's velocity, set in u, against its position from N*); the operator in
+    q2 at (L, 0) is linearize()'s A = [[0, 1], [-9.8/L, 0]] exactly. Without a frame to show
+    them, the speeds are refused in one line that says why."""
+    import dataclasses
+
+    module = _module("pendulum_kane_nonminimal")
+    d = _derive(module)
+    assert d.route == "multipliers" and d.constraints["independent"] == ["q2"]
+    L = sp.Symbol("L")
+    at = {sp.Symbol("q1"): L, sp.Symbol("q2"): 0}
+    K, M = (sp.nsimplify(X[0].xreplace(at)) for X in (d.operator.K, d.operator.M))
+    assert sp.simplify(K / M - sp.Rational(98, 10) / L) == 0
+    with pytest.raises(Unsupported, match=r"the speed u1 of q1 enters no velocity .*: beside holonomic "
+                                          r"constraints, speeds are taken as their coordinates' rates"):
+        pipeline.derive(dataclasses.replace(module.build(), frame=None, loads=[]), pipeline.Steps(out=io.StringIO()))

@@ -189,24 +189,46 @@ def median(runs: list) -> dict | None:
     return {k: statistics.median(r[k] for r in done) for k in done[0]} | {"runs": len(done)}
 
 
-def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def interleaved(codes: dict, repeats: int, timeout: float) -> dict:
+    """Each side's child (`codes`: side -> code) run once uncounted (its bytecode written),
+    then `repeats` times, the sides interleaved (a change of the machine's load meets both):
+    side -> the medians of its times (`median`)."""
+    runs = {side: [] for side in codes}
+    for code in codes.values():
+        child(code, timeout)
+    for _ in range(repeats):
+        for side, code in codes.items():
+            runs[side].append(child(code, timeout))
+    return {side: median(r) for side, r in runs.items()}
+
+
+def arguments(argv, repeats: int, folder: Path):
+    """The bench's command line (--timeout, --repeats, --only NAME...: of the model files in
+    `folder`, args.names, all of them by default), with the children's bytecode cached in a
+    folder of the bench's own, as an installed package runs (module doc)."""
+    where = folder.relative_to(ROOT)
+    ap = argparse.ArgumentParser(description=sys.modules["__main__"].__doc__.splitlines()[0])
     ap.add_argument("--timeout", type=float, default=300.0, help="seconds per child process")
-    ap.add_argument("--repeats", type=int, default=5, help="runs per side; the median is kept")
-    ap.add_argument("--only", nargs="*", help="these models of tests/models only")
+    ap.add_argument("--repeats", type=int, default=repeats, help="runs per side; the median is kept")
+    ap.add_argument("--only", nargs="*", help=f"these models of {where} only")
     args = ap.parse_args(argv)
     sys.path.insert(0, str(ROOT))
+    os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
+    os.environ["PYTHONPYCACHEPREFIX"] = str(Path(tempfile.gettempdir()) / "gyro-bench-pycache")
+    args.names = args.only or sorted(p.stem for p in folder.glob("*.py") if not p.stem.startswith("_"))
+    return args
+
+
+def main(argv=None) -> None:
+    args = arguments(argv, 5, MODELS)
     import io
 
     from derive import pipeline
     from derive.__main__ import build, load_file
     from derive.model import Unsupported
 
-    os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
-    os.environ["PYTHONPYCACHEPREFIX"] = str(Path(tempfile.gettempdir()) / "gyro-bench-pycache")
-    names = args.only or sorted(p.stem for p in MODELS.glob("*.py") if not p.stem.startswith("_"))
     rows = []
-    for name in names:
+    for name in args.names:
         path = str(MODELS / f"{name}.py")
         model = build(load_file(path))
         row = {"system": name, "sympy_input": "system()" if name in SYSTEMS else "translated"}
@@ -219,13 +241,7 @@ def main(argv=None) -> None:
         if name not in SYSTEMS:
             row["equations_differ_by"] = check_equal(name, model, d)
         codes = {"ours": OURS.format(folder=str(MODELS), path=path), "sympy": sympy_code(name, model)}
-        runs = {side: [] for side in codes}
-        for side, code in codes.items():
-            child(code, args.timeout)  # bytecode written, not counted
-        for _ in range(args.repeats):  # the sides interleaved: a change of the machine's load meets both
-            for side, code in codes.items():
-                runs[side].append(child(code, args.timeout))
-        sides = {side: median(r) for side, r in runs.items()}
+        sides = interleaved(codes, args.repeats, args.timeout)
         row.update(sides)
         if sides["ours"] and sides["sympy"]:
             for key in ("whole_cpu_s", "derive_cpu_s", "whole_s", "derive_s"):

@@ -9,6 +9,7 @@ import os
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
+import gc  # noqa: E402
 import hashlib  # noqa: E402
 import importlib  # noqa: E402
 import importlib.util  # noqa: E402
@@ -17,7 +18,7 @@ import time  # noqa: E402
 from contextlib import contextmanager  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-from derive import emit, parallel, pipeline  # noqa: E402
+from derive import convert, emit, parallel, pipeline  # noqa: E402
 from derive.model import Model, Unsupported  # noqa: E402
 from derive.models import MODELS  # noqa: E402
 
@@ -110,13 +111,20 @@ def build(module) -> Model:
     where = getattr(module, "__file__", module.__name__)
     if not callable(getattr(module, "build", None)):
         raise NotAModel(f"{where}: not a model: it defines no build() function")
+    collecting = gc.isenabled()
+    gc.disable()  # the points of the bodies build() formed its Lagrangian of live until taken
     try:
         with namespace(module):
             model = module.build()
+        if isinstance(model, Model):
+            model._live_points = convert.live_points(model)  # noqa: SLF001 - read by convert
     except Unsupported:
         raise
     except Exception as exc:  # the model file's own error, in one line
         raise NotAModel(f"{where}: build() failed: {type(exc).__name__}: {_first_line(exc)}") from exc
+    finally:
+        if collecting:
+            gc.enable()
     if not isinstance(model, Model):
         raise NotAModel(f"{where}: not a model: build() returned {type(model).__name__}, not derive.model.Model")
     if sys.modules.get(model.module) is not module:

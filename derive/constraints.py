@@ -186,7 +186,7 @@ def projection(model: Model, held) -> sp.Matrix:
     C = sp.zeros(n, n - m)
     for k, i in enumerate(ind):
         C[i, k] = 1
-    Cdep = -P_dep.inv() * P_ind
+    Cdep = -P_dep.inv(method="ADJ") * P_ind  # adjugate over det: GE's pivot search simplifies (4.4 s)
     for r, i in enumerate(dep):
         for k in range(n - m):
             C[i, k] = Cdep[r, k]
@@ -198,7 +198,7 @@ def constrained_operator(held, C: sp.Matrix, E0: sp.Matrix, f0: sp.Matrix, q, qd
     """The operator about rest in the independent coordinates, as sympy's linearize gives
     it: lambda0 from the dependent rows at rest (Phi_dep' lambda0 = f_dep), then
     M = C' Mq C, D = C' (dE/dq') C, K = C' (dE/dq + sum_j lambda0_j d2 phi_j/dq2) C."""
-    lam0 = held.P_dep.T.inv() * sp.Matrix([f0[i] for i in held.dep])
+    lam0 = held.P_dep.T.inv(method="ADJ") * sp.Matrix([f0[i] for i in held.dep])
     H = sp.zeros(len(q), len(q))
     for j, phi in enumerate(held.phis):
         H += lam0[j] * sp.hessian(phi, q)

@@ -7,10 +7,15 @@ coordinates, their rates and accelerations, with no assumptions.
   name). `qd` and `qdd` may be left empty, or given as speeds `dynamicsymbols('u')`. With
   kinematic equations (`kinematics`, KanesMethod's kd_eqs) a speed is what they say: every
   u is replaced by its expression in q and q', and the record of q' = V u + v goes to the
-  derivation, which forms the equations in the speeds (derive/passes/speeds.py). Without
+  derivation, which forms the equations in the speeds (derive/passes/speeds.py); with
+  holonomic constraints only kinematic equations u_i = q_i' (a joint's) are taken, the
+  speeds then being the rates. Without
   them a speed stands for its coordinate's derivative, and must be it in every velocity of
-  the model's frames and load points it enters; a speed that is not, or that enters none
-  the machinery can see, is refused (_check_rates), never guessed.
+  the model's frames and points it enters; a speed that is not, or that enters none
+  the machinery can see, is refused (_check_velocities), never guessed. Every velocity
+  the model's frames and points set must be the time derivative of their orientation or
+  position: one that is not holds a velocity constraint (a rolling disc formed from its
+  contact point up), nonholonomic, refused.
 - Any other function of time, F(t), is an input: the `Signal` of that name when the model
   declares one (its rungs F, F_d, ... for F, F', ...), else an input signal made here of
   the order the derivation needs, as sympy's linearize takes every such function as an
@@ -181,28 +186,59 @@ def _kinematics(model: Model):
     return us, dict(zip(us, solve_u)), V, v
 
 
+def _rates_themselves(kin) -> bool:
+    """The kinematic equations say u_i = q_i' for each i, in order (q' = V u + v with V the
+    identity and v zero), as the kdes of sympy's joints do."""
+    V, v = kin[2], kin[3]
+    return all(sp.expand(e) == 0 for e in list(V - sp.eye(V.rows)) + list(v))
+
+
 def _numerically_zero(exprs, rng) -> bool:
     """Every expression (in functions of time, their derivatives and symbols) zero at two
-    random rational points, to 30 digits."""
+    random rational points, to 30 digits: each value a 30-digit Float, so that every
+    subexpression is evaluated as the values go in (evalf of the exact rationals' tree took
+    4 s of a heavy top's conversion)."""
     exprs = [sp.sympify(e) for e in exprs]
+
+    def value(lo, hi):
+        return sp.Float(sp.Rational(rng.randint(lo, hi), 1000), 30)
+
     for _ in range(2):
         pt = {}
         for e in exprs:
             for d in e.atoms(sp.Derivative):
-                pt.setdefault(d, sp.Rational(rng.randint(-2000, 2000), 1000))
+                pt.setdefault(d, value(-2000, 2000))
         sub = [e.xreplace(pt) for e in exprs]
-        pt2 = {f: sp.Rational(rng.randint(-2000, 2000), 1000) for e in sub for f in e.atoms(AppliedUndef)}
+        pt2 = {f: value(-2000, 2000) for e in sub for f in e.atoms(AppliedUndef)}
         sub = [e.xreplace(pt2) for e in sub]
-        pt3 = {s: sp.Rational(rng.randint(500, 2000), 1000) for e in sub for s in e.free_symbols}
+        pt3 = {s: value(500, 2000) for e in sub for s in e.free_symbols}
         if any(abs(complex(sp.N(e.xreplace(pt3), 30))) > 1e-20 for e in sub):
             return False
     return True
 
 
+def live_points(model: Model) -> list:
+    """The points alive now whose velocity in the model's inertial frame (that very object)
+    is set: those of the bodies and particles its Lagrangian was formed of, which nothing
+    else holds (a Lagrangian is a scalar). Points that locate one another hold each other
+    in a cycle, so they live until the cyclic collector runs: derive.__main__.build takes
+    them right after build() returns, with the collector held off meanwhile, and keeps them
+    on the model (`_live_points`); a model built elsewhere is scanned when it is converted."""
+    types = _vector_types()
+    if model.frame is None or types is None:
+        return []
+    import gc
+
+    return [o for o in gc.get_objects() if isinstance(o, types[1])
+            and any(f is model.frame for f in getattr(o, "_vel_dict", {}))]
+
+
 def _frames_and_points(model: Model):
     """The reference frames connected to the model's inertial frame by orientations or set
-    angular velocities, and the points of its loads with those connected to them by
-    positions or velocities."""
+    angular velocities; the points whose velocity in that frame (the very object) is set
+    (those of its bodies and particles, found among the live objects: a Lagrangian is a
+    scalar, and the bodies it was formed of are nowhere else), the points of its loads, and
+    those connected to them by positions."""
     frames, todo = [], [model.frame] if model.frame is not None else []
     while todo:
         f = todo.pop()
@@ -218,6 +254,8 @@ def _frames_and_points(model: Model):
             where = ld[0]
         if types is not None and isinstance(where, types[1]):
             todo.append(where)
+    live = getattr(model, "_live_points", None)
+    todo += live if live is not None else live_points(model)
     while todo:
         p = todo.pop()
         if any(p is g for g in points):
@@ -227,45 +265,83 @@ def _frames_and_points(model: Model):
     return frames, points
 
 
-def _check_rates(model: Model, claimed: list) -> None:
-    """Speeds given without kinematic equations, u(t) in `qd` for q(t), stand for q'(t):
-    each must be its coordinate's derivative in every velocity of the model's frames and
-    points that it enters (a set angular velocity against the one its orientation gives,
-    a set velocity against its neighbour's plus the derivative of the position between
-    them). A speed that is not, or that enters no velocity the machinery can check (the
-    Lagrangian is a scalar: it cannot tell u from q'), is refused in one line: kinematic
-    equations say what a speed is (Model.kinematics)."""
+def _w_of_dcm(f, other):
+    """The angular velocity of f in other that f's orientation gives, in f's components
+    (w x = C C'^T in f, C = f.dcm(other)), as it comes: sympy's own (_w_diff_dcm)
+    trigsimps each component, 4 s of a heavy top's 4.6 s conversion."""
+    C = f.dcm(other)
+    Cd = C.applyfunc(lambda e: e.diff(TIME))
+    return C.row(2).dot(Cd.row(1)) * f.x + C.row(0).dot(Cd.row(2)) * f.y + C.row(1).dot(Cd.row(0)) * f.z
+
+
+ORIENTATION = "its orientation gives"
+
+
+def _check_velocities(model: Model, claimed: list, kin, as_kdes: bool = False) -> None:
+    """Every velocity the model's points set, and every angular velocity its frames set in
+    speeds, held to the one their position or orientation gives: a set velocity against its
+    neighbour's plus the time derivative of the position between them (each pair once), a
+    set angular velocity against the one its orientation gives (one in q' alone is the one
+    sympy's orientation set), with each speed what it is (its expression in q and q' where
+    kinematic equations say, else the rate of its coordinate). At two random points, to 30
+    digits.
+
+    A mismatch where a speed given without kinematic equations (u(t) in `qd` for q(t))
+    enters is that speed not being its coordinate's rate: refused in one line, kinematic
+    equations say what a speed is (Model.kinematics). Any other is a velocity that is no
+    time derivative of a position, a velocity constraint built into the kinematics (a disc
+    formed from its contact point up, whose centre's velocity is the rolling constraint):
+    nonholonomic, refused in one line (Lagrange's equations of such a Lagrangian are not
+    the system's, and LagrangesMethod's are not KanesMethod's). A claimed speed that enters
+    no velocity the machinery can check is refused too (the Lagrangian is a scalar: it
+    cannot tell u from q')."""
     import random
 
     rng = random.Random(0)
     as_rate = {u: x.diff(TIME) for x, u in claimed}
+    speeds = dict(kin[1]) if kin else {}
+    sub = {**as_rate, **speeds}
     seen: set = set()
     fix = ("give the kinematic equations (kinematics=[q' - u, ...] or the body's, as KanesMethod's "
            "kd_eqs), or write the coordinate's derivative itself")
+    if as_kdes:  # kinematic equations u = q' beside holonomic constraints: rates, to be shown as such
+        fix = ("beside holonomic constraints, speeds are taken as their coordinates' rates (kinematic "
+               "equations u = q'), and must be shown to be them in the model's frame")
     frames, points = _frames_and_points(model)
     checks = []
     for f in frames:
         for other, w in getattr(f, "_ang_vel_dict", {}).items():
             if other in getattr(f, "_dcm_dict", {}) and f is not model.frame:  # each pair from its body's side
-                checks.append((w, lambda f=f, other=other: f._w_diff_dcm(other), other,
-                               f"the angular velocity of {f} in {other}"))
+                checks.append((w, lambda f=f, other=other: _w_of_dcm(f, other), other,
+                               f"the angular velocity of {f} in {other}", ORIENTATION, (w,)))
     inertial = model.frame
+    pairs = set()
     for p in points:
         vp = getattr(p, "_vel_dict", {}).get(inertial)
         for o, r in getattr(p, "_pos_dict", {}).items():
             vo = getattr(o, "_vel_dict", {}).get(inertial)
-            if vp is not None and vo is not None:
-                checks.append((vp, lambda vo=vo, r=r: vo + r.dt(inertial), inertial, f"the velocity of {p} in {inertial}"))
-    for w, implied, frame, what in checks:
-        inside = [u for u in as_rate if w.args and any(m.has(u) for m, _ in w.args)]
-        if not inside:
+            if vp is not None and vo is not None and (id(o), id(p)) not in pairs:  # each pair once
+                pairs.add((id(p), id(o)))
+                checks.append((vp, lambda vo=vo, r=r: vo + r.dt(inertial), inertial,
+                               f"the velocity of {p} in {inertial}", f"its position from {o} gives", (vp, vo)))
+    given = list(sub)
+    for w, implied, frame, what, gives, entered in checks:  # a speed in either velocity of a pair is checked
+        inside = [u for u in as_rate if any(v.args and any(m.has(u) for m, _ in v.args) for v in entered)]
+        if gives == ORIENTATION and not (given and w.args and any(m.has(*given) for m, _ in w.args)):
+            continue  # an angular velocity in q' alone: the one its orientation set (sympy's orient)
+        try:
+            diff = (w.xreplace(sub) - implied().xreplace(sub)).to_matrix(frame)
+        except Exception:  # frames not oriented to each other: nothing to hold it to
             continue
-        diff = (w.subs(as_rate) - implied()).to_matrix(frame)
         if not _numerically_zero(list(diff), rng):
-            u = inside[0]
-            x = next(x for x, v in claimed if v == u)
-            raise Unsupported(f"{model.name}: the speed {type(u).__name__} is not the rate of "
-                              f"{type(x).__name__} in {what}: {fix}")
+            if inside:
+                u = inside[0]
+                x = next(x for x, v in claimed if v == u)
+                raise Unsupported(f"{model.name}: the speed {type(u).__name__} is not the rate of "
+                                  f"{type(x).__name__} in {what}: {fix}")
+            raise Unsupported(f"{model.name}: {what} is not the one {gives}: a velocity constraint (rolling "
+                              "without slip?) is nonholonomic, which the machinery does not derive; write "
+                              "the velocities as time derivatives of positions")
         seen.update(inside)
     unchecked = [u for _, u in claimed if u not in seen]
     if unchecked:
@@ -393,9 +469,14 @@ def _convert(model: Model) -> Model:
     loads = [ld if isinstance(ld, Load) and not (_is_vector(ld.vector) or _is_vector(ld.velocity))
              else _load(ld, model.frame, f"{model.name}: load {k + 1}") for k, ld in enumerate(model.loads)]
     kin = _kinematics(model)
+    as_kdes = bool(kin and model.holonomic and _rates_themselves(kin))
+    if as_kdes:
+        # u_i = q_i' (a joint's kdes): the speeds are the rates, claimed and checked as such, and
+        # the constraints take the route of a model in rates (speeds with constraints are not derived)
+        model, kin = dataclasses.replace(model, kinematics=[]), None
     mapping, q, qd, qdd, claimed = _dynamic_rates(dataclasses.replace(model, qd=[], qdd=[]) if kin else model)
-    if claimed:
-        _check_rates(model, claimed)
+    if claimed or model.frame is not None:
+        _check_velocities(model, claimed, kin, as_kdes)
     # with kinematic equations, each speed u(t) is its expression in q and q' everywhere
     speed_sub = {}
     if kin:

@@ -15,7 +15,8 @@ converges on and hands every other back to the NumPy iteration (_newton_numpy). 
 answer, of either, is then held to the equations (residual_test: each residual below
 RESIDUAL_TOL of the size of its terms); a set that Newton left off balance after
 converging (a singular K at the start: the least-squares step is zero along its null
-direction) is tried again from moved starts (RESTARTS), and a set balanced by none is
+direction) or that could not start (the equations undefined at the start) is tried again
+from moved starts (RESTARTS), and a set balanced by none is
 refused (why_not says which equation keeps which residual)."""
 from __future__ import annotations
 
@@ -277,7 +278,15 @@ def _solve(model: Model, P, q0, idx, is_angle, tol, max_iter):
     report = {"ratio": ratio, "row": row, "value": value, "q": qe.copy(), "restarted": converged & ~balanced}
     # Newton that could not start: it "converged" (a zero least-squares step along the null
     # direction of a singular K) where the equations do not hold; again from other starts
-    stuck = np.flatnonzero(converged & finite & ~balanced & np.all(np.isfinite(P), axis=1))
+    stuck = converged & finite & ~balanced
+    # or could not start at all: the equations are not defined at the start (a spring on a
+    # pathway of zero length there, k q x0/sqrt(q^2) at q = 0: 0/0)
+    lost = np.flatnonzero(~finite & np.all(np.isfinite(P), axis=1))
+    if lost.size:
+        with np.errstate(all="ignore"):
+            r0 = _rows(model, idx)(P[lost], q0[lost])
+        stuck[lost[~np.all(np.isfinite(r0), axis=1)]] = True
+    stuck = np.flatnonzero(stuck & np.all(np.isfinite(P), axis=1))
     for shift in RESTARTS:
         if stuck.size == 0:
             break

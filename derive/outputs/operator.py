@@ -11,6 +11,18 @@ P_SYMBOL = sp.Symbol("p")
 MATRICES = ("M", "D", "K", "J", "J_re", "J_im", "Mq", "G", "Ds", "Ks", "Kc", "B")
 
 
+# an entry of more operations than this is emitted as it comes, not expanded: expand has no
+# bound on its work, and a four-bar on sympy's joints (relative angles, two multipliers) has
+# a K of 7,370 operations whose expansion took 85 s; the parts' cancellations it would find
+# are exact zeros that rounding gives as 1e-16 of the entry instead (the paper models'
+# largest entry, the torsion gyrocompass's K_s, has 1,125: expanded as before)
+EXPAND_OPS = 2000
+
+
+def _tidy(X: sp.Matrix) -> sp.Matrix:
+    return X.applyfunc(lambda e: sp.expand(e) if sp.count_ops(e) <= EXPAND_OPS else e)
+
+
 def functions(d) -> list[Function]:
     state, op = d.state(), d.operator
     coords = ", ".join(d.order)
@@ -33,8 +45,7 @@ def functions(d) -> list[Function]:
         G, Ds = half * (op.D - op.D.T), half * (op.D + op.D.T)
         Ks, Kc = half * (op.K + op.K.T), half * (op.K - op.K.T)
         fns.append(Function("operator_parts", state,
-                            [("G", G.applyfunc(sp.expand)), ("Ds", Ds.applyfunc(sp.expand)),
-                             ("Ks", Ks.applyfunc(sp.expand)), ("Kc", Kc.applyfunc(sp.expand))],
+                            [("G", _tidy(G)), ("Ds", _tidy(Ds)), ("Ks", _tidy(Ks)), ("Kc", _tidy(Kc))],
                             "Parts of the operator: D = G + Ds with G skew (gyroscopic, Coriolis) "
                             "and Ds symmetric (dissipation), K = Ks + Kc with Ks symmetric "
                             "(potential) and Kc skew (circulatory).", MATRICES))

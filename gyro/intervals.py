@@ -227,6 +227,7 @@ def _ops():
 
 
 _OPS: dict = {}
+CHUNK = 8192  # boxes evaluated at once (each register holds two arrays of this length)
 _PROGRAMS: dict = {}
 
 
@@ -287,6 +288,12 @@ def evaluate(fun, inputs):
     column-major, its structural zeros 0): for every point of the boxes,
     the Function's exact value lies in [lo, hi]; [-inf, inf] where it is not enclosed."""
     prog = program(fun)
+    width = max((np.shape(x)[1] for b in inputs for x in b if np.ndim(x) == 2), default=0)
+    if width > CHUNK:  # the work vector's registers for all boxes at once would not fit: in pieces
+        parts = [evaluate(fun, [tuple(x[:, k:k + CHUNK] if np.ndim(x) == 2 else x for x in b) for b in inputs])
+                 for k in range(0, width, CHUNK)]
+        return [(np.concatenate([p[i][0] for p in parts], axis=1), np.concatenate([p[i][1] for p in parts], axis=1))
+                for i in range(len(parts[0]))]
     ins = []
     for (lo, hi), n in zip(inputs, prog.n_in):
         lo, hi = np.asarray(lo, float), np.asarray(hi, float)
@@ -309,19 +316,20 @@ def evaluate(fun, inputs):
     return result
 
 
-def centred(fun, jac, which: int, inputs):
+def centred(fun, jac, which: int, inputs, natural: bool = True):
     """The mean-value form over the boxes, intersected with the natural extension: f(X) in
     f(c) + J(X) (X - c), c the boxes' centres in input `which` (the others as given), J(X)
     the interval Jacobian of every output in that input (`jac`, a Function of the same
     inputs giving d out_k / d in_which for each output k, dense, (nnz_out_k, nnz_which)
     nonzeros column-major). Tight to the square of the boxes' widths where the natural
     extension is to their width (cancellations: residuals, differences of near-equal
-    terms). Returns per output a pair (lo, hi) as `evaluate`."""
+    terms). `natural` False: the mean-value form alone (the caller has the natural
+    extension already). Returns per output a pair (lo, hi) as `evaluate`."""
     lo, hi = (np.asarray(x, float) for x in inputs[which])
     c = lo + (hi - lo) / 2  # a point inside the box (rounded: any point inside will do)
     c = np.minimum(np.maximum(c, lo), hi)
     at_c = evaluate(fun, [(c, c) if k == which else x for k, x in enumerate(inputs)])
-    natural = evaluate(fun, inputs)
+    natural = evaluate(fun, inputs) if natural else [(-INF, INF)] * len(at_c)
     J = evaluate(jac, inputs)
     d = (down(lo - c), up(hi - c))  # X - c, rounded outward (lo - c <= 0 <= hi - c)
     d = (np.minimum(d[0], 0.0), np.maximum(d[1], 0.0))
@@ -398,9 +406,10 @@ def definite_below(lo, hi, t):
 def lambda_max_upper(lo, hi):
     """An upper bound of the largest eigenvalue of every symmetric matrix in the box [lo, hi]
     (n, k, k), k <= 3: Weyl's, lambda_max(mid) + ||rad||_F (rad the box's half widths,
-    ||rad||_2 <= ||rad||_F), with a margin for the eigensolver's rounding, verified by
-    `definite_below`; where the check fails, Gershgorin's (a_ii + sum |a_ij|, always an
-    upper bound); the smaller of the two where both hold. inf where the box is not finite."""
+    ||rad||_2 <= ||rad||_F), lambda_max(mid) the eigensolver's plus a margin for its
+    rounding, verified by `definite_below` on the point mid; where that check fails,
+    Gershgorin's (a_ii + sum |a_ij|, always an upper bound); the smaller of the two where
+    both hold. inf where the box is not finite."""
     finite = np.all(np.isfinite(lo) & np.isfinite(hi), axis=(-2, -1))
     lo = np.where(finite[:, None, None], lo, 0.0)
     hi = np.where(finite[:, None, None], hi, 0.0)
@@ -409,14 +418,13 @@ def lambda_max_upper(lo, hi):
     rad = up(np.maximum(up(mid - lo), up(hi - mid)))
     fro = up(np.sqrt(up(np.sum(rad * rad, axis=(-2, -1)) * (1 + 4 * rad.shape[-1] ** 2 * EPS))))
     scale = np.sqrt(np.sum(mid * mid, axis=(-2, -1)))
-    lam = np.linalg.eigvalsh(mid)[:, -1]
-    t = up(lam + fro + 1e-12 * scale) + 1e-300
-    ok = definite_below(lo, hi, t)
+    t_mid = up(np.linalg.eigvalsh(mid)[:, -1] + 1e-12 * scale) + 1e-300
+    ok = definite_below(mid, mid, t_mid)
     k = lo.shape[-1]
     off = np.sum(np.maximum(np.abs(lo), np.abs(hi)), axis=-1) - np.maximum(np.abs(np.diagonal(lo, 0, -2, -1)),
                                                                            np.abs(np.diagonal(hi, 0, -2, -1)))
     gersh = up(np.max(up(np.diagonal(hi, 0, -2, -1) + up(off * (1 + 4 * k * EPS))), axis=-1))
-    out = np.where(ok, np.minimum(t, gersh), gersh)
+    out = np.where(ok, np.minimum(up(t_mid + fro), gersh), gersh)
     return np.where(finite, out, INF)
 
 

@@ -531,34 +531,33 @@ def image_error(a, b) -> float:
 #   + |G sigma| + |G d_l|, E(0) = |G B P(0)| (full starts on (13): w(0) = 0), mu the
 #   logarithmic norm of G DPhi G^-1 + G' G^-1 over the tube, L the norm of G DPhi G^-1;
 # - the error s - s_l within E + |G B P| on the sphere, the image point within rho^2 of it.
-# Every constant is the largest over the tube |G (s - s_l)| <= r about the level's motion
-# (the centre and the six axial points at radius r, with twice their spread as the
-# allowance for the rest of the ball) and over each step (the larger end plus the steps'
-# difference as the allowance between samples, plus a floor: FLOOR_ALLOWANCE). The radius
-# is closed by a bootstrap: the bound computed with the constants of radius r must come out below r, else r is raised;
-# a tube that reaches beta or alpha = +-90 deg, or no closing within BOOTSTRAP tries: the
-# level refuses (the bound is infinite).
+# Every constant is the largest over the tube |G (s - s_l)| <= r about the level's motion,
+# over each step of the bound's grid, ENCLOSED (gyro/intervals.py, `_enclosed_constants`): the
+# level's motion over a step is held in a box by an a priori enclosure (`_level_boxes`: if
+# s_k + [0, h] R(X) lies in X, R the level's rates over X, the motion stays in X); the full
+# state in that box widened by r / G_j per axis; the tube function (every piece the
+# constants need) evaluated in interval arithmetic over both boxes, outward rounded (the
+# cancelling residuals rho1, eta, sigma also by the centred form f(c) + J(X)(X - c)); the
+# constants from the interval matrices by closed forms (2 x 2 eigenvalues), Weyl's bound
+# with a verified eigenvalue of the midpoint, and norms of the entrywise magnitudes. No
+# sampled allowance, no floor. The radius is closed by a bootstrap: the bound computed with
+# the constants of radius r must come out below r, else r is raised; a tube that reaches
+# beta or alpha = +-90 deg, a step's motion not enclosed, or no closing within BOOTSTRAP
+# tries: the level refuses (the bound is infinite). Where the bound is far from the
+# samples' guess and a step's box is wider than the tube, the grid is refined (REFINE).
 # The integrator's term: the answer (Adams, rtol 1e-12) against an independent method (BDF
 # with Newton's iteration, same tolerance) and against Adams 100x looser, twice the larger.
 
 LOOSE = 100.0
 INTEGRATION_SAFETY = 2.0
 PER_RADIAN = 20  # samples of the bound's grid per radian of the fastest frame rate
-MAX_SAMPLES = 200_000  # a motion that needs more: the bound is not evaluated (infinite)
+MAX_SAMPLES = 50_000  # a motion that needs more: the bound is not evaluated (infinite; the intervals' cost)
 MIN_SAMPLES = 401  # the bound's grid has at least these
+REFINE = (1, 4)  # the bound's grid: these times finer in turn, while the bound is far from its guess
+REFINE_CLOSE = 1.5  # a bound within this factor of the samples' guess: no finer grid
+REFINE_MAX_SAMPLES = 5_000  # a refined grid no longer than this (its cost)
 BOOTSTRAP = 6  # tries to close the tube's radius
 TUBE_GROWTH = 2.0  # a try that does not close raises the radius to this times its bound
-BALL_ALLOWANCE = 2.0  # the tube's constant: the centre's plus this times the axial points' spread
-# and each step's plus this times the constant's largest magnitude over the horizon; |rho1|, second
-# order and computed with cancellation, also RHO1_FLOOR times |rho0|'s largest (measured, `python -m
-# bench.precession_bounds 11 --allowances 16`: random points of the ball and a 4x denser grid
-# exceeded the sampled maxima by 3e-7 of that magnitude (|rho1|) where the tube's radius is 1e-10
-# rad or more, 2e-5 at 1e-20..1e-10 rad (|rho1| 0.97, where it is 1e-7..1e-5 of |rho0|), none
-# with the floors; 0.98 on motions of rounding size, a model term of 1e-26 against the
-# integrator's 1e-12)
-FLOOR_ALLOWANCE = 1e-2
-RHO1_FLOOR = 1e-4
-
 
 def _scale(m) -> float:
     return float(np.hypot(m.x - m.x[0], m.y - m.y[0]).max())
@@ -685,16 +684,21 @@ def _constants(c: dict, Gd: np.ndarray, Gdot: np.ndarray, kappa: np.ndarray) -> 
             "s2": np.sqrt(np.sum((Gd[:, :, None, None] * c["s2"])**2, axis=(1, 2, 3)))}
 
 
-def _bound_grid(values: dict, m):
+def _bound_grid(values: dict, m, factor: int = 1):
     """The level's motion on a grid with PER_RADIAN samples per radian of the fastest frame
     rate (the base's |u| plus the largest |alpha'| + |beta'| of (13) on m), at least
-    MIN_SAMPLES: m's own samples, thinned, where it is denser; None where that takes more
-    than MAX_SAMPLES."""
+    MIN_SAMPLES, both times `factor` (a refined grid: the level integrated again with those
+    output times); m's own samples, thinned, where it is denser; None where that takes more
+    than MAX_SAMPLES (REFINE_MAX_SAMPLES for a refined grid)."""
     P = vector(values)
     r3 = _rigorous(P, m.alpha, m.beta, m.H)
     u = float(np.linalg.norm([values[b] for b in BASE]))
     w = u + float(np.max(np.abs(r3[:, 0]) + np.abs(r3[:, 1])))
     n = int(np.ceil(float(m.t[-1]) * w * PER_RADIAN)) + 1
+    if factor > 1:
+        n = (max(n, MIN_SAMPLES, len(m.t)) - 1) * factor + 1
+        if n > REFINE_MAX_SAMPLES:
+            return None
     if n > MAX_SAMPLES:
         return None
     if n > len(m.t):
@@ -838,7 +842,7 @@ def _tube_intervals(values: dict, lo, hi) -> dict:
     (clo, chi), = intervals.evaluate(_tube_function(), [(P, P), (lo.T, hi.T)])
     L, H = _unpack(clo.T), _unpack(chi.T)
     fun, jac = _cancelling_function()
-    (flo, fhi), = intervals.centred(fun, jac, 1, [(P, P), (lo.T, hi.T)])
+    (flo, fhi), = intervals.centred(fun, jac, 1, [(P, P), (lo.T, hi.T)], natural=False)
     k = 0
     for name in CANCELLING:
         size = int(np.prod(_SHAPES[name]))
@@ -869,12 +873,13 @@ def _scale_rows_cols(G, A, cols=True):
     return intervals._div(r, (G[0][:, None, :], G[1][:, None, :]))
 
 
-def _enclosed_constants(values: dict, box, rates_, dl, r: float) -> dict:
+def _enclosed_constants(values: dict, box, rates_, dl, r: float, start) -> dict:
     """The enclosure's constants (docs/precession.md, steps 2-4) over each step: the largest
     (for mmin the smallest) over every time of the step and every state of the tube
     |G (s - s_l)| <= r about it, from interval evaluations: the level's box `box` (n - 1, 3)
     for G, G' G^-1 and kappa = D pi(s_l) s_l', the box widened by r / G_j per axis (G_j's
-    smallest over the step) for the full state's pieces. Each a number per step."""
+    smallest over the step) for the full state's pieces. Each a number per step; "W0" an
+    upper bound of Omega(0) = |eta(s(0))|_Mr at the start `start` (1, 3), a point."""
     iv = intervals
     lo, hi = box
     H0 = abs(float(values["H"]))
@@ -886,8 +891,10 @@ def _enclosed_constants(values: dict, box, rates_, dl, r: float) -> dict:
     inv_h = (iv.down(1 / H0) * ones, iv.up(1 / H0) * ones)
     G = (np.stack([cb[0], ones, inv_h[0]], -1), np.stack([cb[1], ones, inv_h[1]], -1))
     reach = np.stack([iv.up(r / cb[0]), np.full(n, r), np.full(n, iv.up(r * H0))], -1)
-    tube = _tube_intervals(values, iv.down(lo - reach), iv.up(hi + reach))
-    own = _tube_intervals(values, lo, hi)
+    both = _tube_intervals(values, np.vstack([iv.down(lo - reach), lo, start]), np.vstack([iv.up(hi + reach), hi, start]))
+    tube = {k: (x[0][:n], x[1][:n]) for k, x in both.items()}
+    own = {k: (x[0][n:2 * n], x[1][n:2 * n]) for k, x in both.items()}
+    at0 = {k: (x[0][2 * n:], x[1][2 * n:]) for k, x in both.items()}
     # G' G^-1 = diag(-tan(beta_l) beta_l', 0, 0); kappa = D pi(s_l) s_l' (the level's own rates)
     gdot = iv._neg(_imul(iv._tan((lo[:, 1], hi[:, 1])), (rates_[0][:, 1], rates_[1][:, 1])))
     kappa = _matvec(own["Dpi"], rates_)
@@ -928,7 +935,7 @@ def _enclosed_constants(values: dict, box, rates_, dl, r: float) -> dict:
             "chi": iv.norm_upper(iv.mag(_imul(G, sig)), (1,)),
             "s1": iv.norm2_upper(iv.mag(_scale_rows_cols(G, tube["s1"], cols=False))),
             "s2": iv.norm_upper(iv.mag(_imul((G[0][:, :, None, None], G[1][:, :, None, None]), tube["s2"])), (1, 2, 3)),
-            "dl": iv.norm_upper(iv.mag(dlG), (1,))}
+            "dl": iv.norm_upper(iv.mag(dlG), (1,)), "W0": _energy_norm(at0["eta"], at0["Mr"])}
 
 
 def _point_constants(values: dict, g, own: dict) -> dict:
@@ -954,12 +961,8 @@ def _point_defect(values: dict, g) -> np.ndarray:
     return out[3:].T
 
 
-def _initial_energy(values: dict, g) -> float:
-    """An upper bound of Omega(0) = |eta(s(0))|_Mr at the motion's start (a point: a
-    degenerate box)."""
-    s0 = np.array([[g.alpha[0], g.beta[0], g.H[0]]])
-    c = _tube_intervals(values, s0, s0)
-    eta, Mr = c["eta"], c["Mr"]
+def _energy_norm(eta, Mr) -> float:
+    """An upper bound of sqrt(eta.Mr eta) over one box's intervals (1, 2), (1, 2, 2)."""
     q = None
     for i in range(2):
         for j in range(2):
@@ -1037,36 +1040,56 @@ def model_error(values: dict, m, limit: float = np.inf) -> float:
     derivation above); inf where the level refuses: the level's motion over a step is not
     enclosed, the tube does not close within BOOTSTRAP tries, reaches +-90 deg, or the grid
     would be too fine; inf also where a try's bound reaches `limit` (a bound no use: the
-    caller's relative bound would be >= 1). The first radius is a guess from the
-    constants at the samples; each try's constants are enclosed over the tube of that radius
-    (`_enclosed_constants`), and the tube is closed where the bound they give is below it."""
-    g = _bound_grid(values, m)
-    if g is None:
-        return float("inf")
-    lb = _level_boxes(values, g)
-    if lb is None:
-        return float("inf")
-    box, rates_, dl = lb
+    caller's relative bound would be >= 1). On the grid of PER_RADIAN samples per radian, then
+    (where that bound is infinite or above REFINE_CLOSE times the samples' guess) on grids
+    REFINE times finer, where a step's box is wider than the tube (the intervals' excess
+    falls as the square of a step's width; where the tube's radius is the wider, a finer grid
+    does not help). Every bound found is an enclosure; the smallest is returned."""
+    best = float("inf")
+    for factor in REFINE:
+        g = _bound_grid(values, m, factor)
+        if g is None:
+            break
+        bound_, guess, wide = _model_error_on(values, g, min(limit, best))
+        best = min(best, bound_)
+        if not (np.isfinite(guess) and wide) or best <= REFINE_CLOSE * guess:
+            break
+    return best
+
+
+def _model_error_on(values: dict, g, limit: float):
+    """(the enclosure on the grid g, the guess's image bound, whether a step's box is wider
+    than the guessed tube in alpha or beta): the first radius is a guess
+    from the constants at the samples; each try's constants are enclosed over the tube of
+    that radius (`_enclosed_constants`), and the tube is closed where the bound they give is
+    below it."""
+    inf = float("inf")
     own = _at(values, np.stack([g.alpha, g.beta, g.H], axis=-1))
     _, guess = _enclosure(values, g, own, 0.0, limit)
     if not np.isfinite(guess):
-        return float("inf")
+        return inf, inf, False
+    lb = _level_boxes(values, g)
+    if lb is None:
+        return inf, inf, False
+    box, rates_, dl = lb
+    guess_image = _image_bound(g, box, guess)
     r = TUBE_GROWTH * guess + 1e-300
+    wide = bool(np.max(box[1][:, :2] - box[0][:, :2]) > r)
     h = intervals.up(np.diff(g.t))
-    W0 = _initial_energy(values, g)
+    start = np.array([[g.alpha[0], g.beta[0], g.H[0]]])
     for _ in range(BOOTSTRAP):
         if np.any(np.maximum(np.abs(box[0][:, 1]), np.abs(box[1][:, 1])) + r >= EDGE):
-            return float("inf")
-        c = _enclosed_constants(values, box, rates_, dl, r)
+            return inf, guess_image, wide
+        c = _enclosed_constants(values, box, rates_, dl, r, start)
         if c is None:
-            return float("inf")
-        worst = _propagate(c, h, W0, limit, rigorous=True)
+            return inf, guess_image, wide
+        worst = _propagate(c, h, c.pop("W0"), limit, rigorous=True)
         if not np.isfinite(worst):
-            return float("inf")
+            return inf, guess_image, wide
         if worst < r:  # closed: the tube of radius r holds the full motion over the horizon
-            return _image_bound(g, box, worst)
+            return _image_bound(g, box, worst), guess_image, wide
         r = TUBE_GROWTH * worst
-    return float("inf")
+    return inf, guess_image, wide
 
 
 def integration_error(values: dict, m) -> float:

@@ -554,7 +554,7 @@ PER_RADIAN = 20  # samples of the bound's grid per radian of the fastest frame r
 MAX_SAMPLES = 50_000  # a motion that needs more: the bound is not evaluated (infinite; the intervals' cost)
 MIN_SAMPLES = 401  # the bound's grid has at least these
 REFINE = (1, 4)  # the bound's grid: these times finer in turn, while the bound is far from its guess
-REFINE_CLOSE = 1.5  # a bound within this factor of the samples' guess: no finer grid
+REFINE_CLOSE = 2.0  # a bound within this factor of the samples' guess: no finer grid
 REFINE_MAX_SAMPLES = 5_000  # a refined grid no longer than this (its cost)
 BOOTSTRAP = 6  # tries to close the tube's radius
 TUBE_GROWTH = 2.0  # a try that does not close raises the radius to this times its bound
@@ -764,7 +764,7 @@ def _level_boxes(values: dict, g):
     grows to the candidate found, half as wide again."""
     S = np.stack([g.alpha, g.beta, g.H], axis=-1)
     a, b = S[:-1], S[1:]
-    h = np.diff(g.t)[:, None]
+    h = intervals.up(np.diff(g.t))[:, None]  # the step lengths, rounded up
     lo = np.minimum(a, b)
     hi = np.maximum(a, b)
     pad = (hi - lo) / 4 + 1e-12 * (1 + np.abs(a))
@@ -778,6 +778,8 @@ def _level_boxes(values: dict, g):
         ylo = np.minimum(intervals.down(a[todo] + intervals.down(h[todo] * Rl)), a[todo])
         yhi = np.maximum(intervals.up(a[todo] + intervals.up(h[todo] * Rh)), a[todo])
         ylo, yhi = np.minimum(ylo, b[todo]), np.maximum(yhi, b[todo])
+        if not (np.all(np.isfinite(ylo)) and np.all(np.isfinite(yhi))):  # rates not enclosed: refused
+            return None
         inside = np.all((ylo >= lo[todo]) & (yhi <= hi[todo]), axis=-1)
         good = todo[inside]
         lo[good], hi[good] = ylo[inside], yhi[inside]
@@ -880,6 +882,11 @@ def _enclosed_constants(values: dict, box, rates_, dl, r: float, start) -> dict:
     for G, G' G^-1 and kappa = D pi(s_l) s_l', the box widened by r / G_j per axis (G_j's
     smallest over the step) for the full state's pieces. Each a number per step; "W0" an
     upper bound of Omega(0) = |eta(s(0))|_Mr at the start `start` (1, 3), a point."""
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # inf and NaN mean refused, below
+        return _enclosed_constants_of(values, box, rates_, dl, r, start)
+
+
+def _enclosed_constants_of(values: dict, box, rates_, dl, r: float, start) -> dict:
     iv = intervals
     lo, hi = box
     H0 = abs(float(values["H"]))
@@ -938,27 +945,30 @@ def _enclosed_constants(values: dict, box, rates_, dl, r: float, start) -> dict:
             "dl": iv.norm_upper(iv.mag(dlG), (1,)), "W0": _energy_norm(at0["eta"], at0["Mr"])}
 
 
-def _point_constants(values: dict, g, own: dict) -> dict:
-    """The constants at the grid's samples (no tube, no step): a first guess of the tube's
-    radius only, never a bound."""
-    cb = np.cos(g.beta)
-    H0 = abs(float(values["H"]))
-    Gd = np.stack([np.abs(cb), np.ones_like(cb), np.full_like(cb, 1 / H0)], axis=-1)
-    dl = _point_defect(values, g)
-    rate = own["Phi"] - dl
-    Gdot = np.stack([-np.tan(g.beta) * rate[:, 1], np.zeros_like(cb), np.zeros_like(cb)], axis=-1)
-    kappa = np.einsum("nij,nj->ni", own["Dpi"], rate)
-    c = _constants(own, Gd, Gdot, kappa)
+def _constants_at(values: dict, level: str, SL: np.ndarray, S: np.ndarray, own_l: dict | None = None,
+                  own: dict | None = None) -> dict:
+    """The constants at the level's states SL (n, 3) (its metric G, G' G^-1, kappa, d_l) and
+    the full states S (n, 3) (the tube's pieces), points: what `_enclosed_constants` holds
+    over a step's box and its tube; `own_l`, `own` the tube function at SL, S if at hand."""
+    P, H0 = vector(values), abs(float(values["H"]))
+    own_l = _at(values, SL) if own_l is None else own_l
+    own = _at(values, S) if own is None else own
+    out = np.array(_level_function(level)(P, SL.T)).T
+    rate, dl = out[:, :3], out[:, 3:]
+    cb = np.cos(SL[:, 1])
+    Gd = np.stack([np.abs(cb), np.ones_like(cb), np.full_like(cb, 1 / H0)], -1)
+    Gdot = np.stack([-np.tan(SL[:, 1]) * rate[:, 1], np.zeros_like(cb), np.zeros_like(cb)], -1)
+    c = _constants(own, Gd, Gdot, np.einsum("nij,nj->ni", own_l["Dpi"], rate))
     c["dl"] = np.linalg.norm(Gd * dl, axis=-1)
+    return c
+
+
+def _point_constants(values: dict, g, own: dict) -> dict:
+    """The constants at the grid's samples (no tube), per step the larger end (the smaller
+    for mmin): a first guess of the tube's radius only, never a bound."""
+    S = np.stack([g.alpha, g.beta, g.H], axis=-1)
+    c = _constants_at(values, g.level, S, S, own, own)
     return {k: np.maximum(v[:-1], v[1:]) if k != "mmin" else np.minimum(v[:-1], v[1:]) for k, v in c.items()}
-
-
-def _point_defect(values: dict, g) -> np.ndarray:
-    if g.level not in ("small", "elementary"):
-        return np.zeros((len(g.t), 3))
-    P = vector(values)
-    out = np.array(_level_function(g.level)(P, np.stack([g.alpha, g.beta, g.H])))
-    return out[3:].T
 
 
 def _energy_norm(eta, Mr) -> float:
@@ -978,17 +988,20 @@ def _propagate(c: dict, h: np.ndarray, W0: float, limit: float, rigorous: bool):
     """Steps 2-4 integrated as upper solutions over the grid with the per-step constants c:
     the largest |G (s - s_l)| over the horizon (inf where it reaches `limit`, overflows, or
     mmin <= 0 or l_pi >= 1). With `rigorous`, the result is raised by (1 + eps)^(32 n) - 1
-    relative: every quantity of the loop is >= 0 and each step takes fewer than 32 roundings
-    (each at most eps relative; exp at most 8 ulps) on the way to the next."""
+    relative: the exponents, 1/(1 - l_pi) and sqrt(m) are rounded outward, and every other
+    quantity of the loop is >= 0, with fewer than 32 roundings per step (each at most eps
+    relative) on the way to the next."""
     if not all(np.all(~np.isnan(x)) for x in c.values()) or not (np.all(c["mmin"] > 0) and np.all(c["Lpi"] < 1)):
         return float("inf")
     E = worst = 0.0
     W = W0
-    k1 = 1 / (1 - c["Lpi"])
+    up, down = intervals.up, intervals.down
+    k1 = up(1 / down(1 - c["Lpi"]))
     with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused below, not warned
-        gl = np.exp(c["lam"] * h)
-        gm = np.exp((c["mu"] + c["L"] * c["Lpi"] * k1) * h)
-        sq = np.sqrt(c["mmin"])
+        # the exponents rounded up (mu may be negative: a signed sum), the rest nonnegative
+        gl = up(np.exp(up(c["lam"] * h)), intervals.TRANSCENDENTAL_ULPS)
+        gm = up(np.exp(up(up(c["mu"] + up(up(c["L"] * c["Lpi"]) * k1)) * h)), intervals.TRANSCENDENTAL_ULPS)
+        sq = down(np.sqrt(c["mmin"]))
         for k in range(len(h)):
             Wsup = (W + h[k] * c["rho"][k]) * max(1.0, gl[k])  # |w|_Mr over the step
             W = W * gl[k] + h[k] * c["rho"][k] * max(1.0, gl[k])

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from gyro import intervals
 from gyro.systems import gimbal_precession as pr
 
 # every term of the proof on (tests/paper/test_precession_bounds.py's PROOF_SET)
@@ -18,18 +17,7 @@ PROOF_SET = {"alpha0": 0.3, "beta0": -0.7, "H": 0.6, "u_xi": 0.4, "u_eta": -0.3,
 
 
 def _point_constants(v, level, SL, S):
-    """The constants at the level's states SL (n, 3) (its metric G, G' G^-1, kappa, d_l) and
-    the full states S (n, 3) (the tube's pieces): what `_enclosed_constants` must hold."""
-    P, H0 = pr.vector(v), abs(float(v["H"]))
-    own_l, own = pr._at(v, SL), pr._at(v, S)
-    out = np.array(pr._level_function(level)(P, SL.T)).T
-    rate, dl = out[:, :3], out[:, 3:]
-    cb = np.cos(SL[:, 1])
-    Gd = np.stack([np.abs(cb), np.ones_like(cb), np.full_like(cb, 1 / H0)], -1)
-    Gdot = np.stack([-np.tan(SL[:, 1]) * rate[:, 1], 0 * cb, 0 * cb], -1)
-    c = pr._constants(own, Gd, Gdot, np.einsum("nij,nj->ni", own_l["Dpi"], rate))
-    c["dl"] = np.linalg.norm(Gd * dl, axis=-1)
-    return c
+    return pr._constants_at(v, level, SL, S)
 
 
 def _in_tube(v, SL, r, rng):

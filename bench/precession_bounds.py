@@ -151,7 +151,7 @@ def enclosure(seed, n, pr):
             continue
         g = pr._bound_grid(v, m)
         S = np.stack([g.alpha, g.beta, g.H], -1)
-        _, guess = pr._enclosure(v, g, pr._at(v, S), 0.0)
+        guess = pr._guess(v, g, pr._at(v, S))
         rad = pr.TUBE_GROWTH * guess + 1e-300
         box, rates_, dl = pr._level_boxes(v, g)
         pick = np.sort(rng.choice(len(box[0]), min(40, len(box[0])), replace=False))

@@ -1039,13 +1039,12 @@ def _image_bound(g, box, worst: float) -> float:
     return float(np.max(np.maximum(1.0, cos_b) / c_far**2) * worst * (1 + 1e-12))
 
 
-def _enclosure(values: dict, g, own: dict, r: float, limit: float = np.inf):
-    """(the largest |P_level - P_full| over the horizon, the largest |G (s - s_l)|) with the
-    constants at the grid's samples and no tube: a first guess of the radius, not a bound."""
+def _guess(values: dict, g, own: dict, limit: float = np.inf) -> float:
+    """The largest |G (s - s_l)| with the constants at the grid's samples and no tube: the
+    first radius of the bootstrap, never a bound; `own` the tube function at the samples."""
     c = _point_constants(values, g, own)
     W0 = float(np.sqrt(own["eta"][0] @ own["Mr"][0] @ own["eta"][0]))
-    worst = _propagate(c, np.diff(g.t), W0, limit, rigorous=False)
-    return float("inf"), worst
+    return _propagate(c, np.diff(g.t), W0, limit, rigorous=False)
 
 
 def model_error(values: dict, m, limit: float = np.inf) -> float:
@@ -1078,7 +1077,7 @@ def _model_error_on(values: dict, g, limit: float):
     below it."""
     inf = float("inf")
     own = _at(values, np.stack([g.alpha, g.beta, g.H], axis=-1))
-    _, guess = _enclosure(values, g, own, 0.0, limit)
+    guess = _guess(values, g, own, limit)
     if not np.isfinite(guess):
         return inf, inf, False
     lb = _level_boxes(values, g)

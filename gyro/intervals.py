@@ -205,7 +205,7 @@ def _fmax(a, b):
 
 def _entire(*args):
     """No enclosure here: [-inf, inf] (NaN where an input is NaN: it comes out as [-inf, inf])."""
-    shape = np.broadcast(*[x for a in args for x in a]).shape
+    shape = np.broadcast(*[x for a in args for x in a]).shape if args else ()
     return np.full(shape, -INF), np.full(shape, INF)
 
 
@@ -270,7 +270,11 @@ class Program:
             else:
                 f = ops.get(op)
                 args = [w[j] for j in i]
-                w[o[0]] = f(*args) if f is not None else entire(*args)
+                if f is not None:
+                    w[o[0]] = f(*args)
+                else:  # no extension here: every output of the instruction (a call may have several)
+                    for j in o:
+                        w[j] = entire(*args)
         return outs
 
 

@@ -71,6 +71,8 @@ def _twice(a):
 
 
 def _mul(a, b):
+    if np.all(a[0] >= 0) and np.all(b[0] >= 0):  # both nonnegative in every box: the ends' products
+        return down(a[0] * b[0]), up(a[1] * b[1])
     p1, p2, p3, p4 = a[0] * b[0], a[0] * b[1], a[1] * b[0], a[1] * b[1]
     lo = np.minimum(np.minimum(p1, p2), np.minimum(p3, p4))
     hi = np.maximum(np.maximum(p1, p2), np.maximum(p3, p4))

@@ -556,6 +556,7 @@ MIN_SAMPLES = 401  # the bound's grid has at least these
 REFINE = (1, 4)  # the bound's grid: these times finer in turn, while the bound is far from its guess
 REFINE_CLOSE = 2.0  # a bound within this factor of the samples' guess: no finer grid
 REFINE_MAX_SAMPLES = 5_000  # a refined grid no longer than this (its cost)
+REFINE_INF = 1e-3  # a refused set is tried on a finer grid only where its guess is below this of the limit
 BOOTSTRAP = 6  # tries to close the tube's radius
 TUBE_GROWTH = 2.0  # a try that does not close raises the radius to this times its bound
 
@@ -1047,16 +1048,18 @@ def _guess(values: dict, g, own: dict, limit: float = np.inf) -> float:
     return _propagate(c, np.diff(g.t), W0, limit, rigorous=False)
 
 
-def model_error(values: dict, m, limit: float = np.inf) -> float:
+def model_error(values: dict, m, limit: float = np.inf, negligible: float = 0.0) -> float:
     """The enclosure of the largest |P_level - P_full| over the horizon (absolute; the
     derivation above); inf where the level refuses: the level's motion over a step is not
     enclosed, the tube does not close within BOOTSTRAP tries, reaches +-90 deg, or the grid
     would be too fine; inf also where a try's bound reaches `limit` (a bound no use: the
     caller's relative bound would be >= 1). On the grid of PER_RADIAN samples per radian, then
-    (where that bound is infinite or above REFINE_CLOSE times the samples' guess) on grids
-    REFINE times finer, where a step's box is wider than the tube (the intervals' excess
-    falls as the square of a step's width; where the tube's radius is the wider, a finer grid
-    does not help). Every bound found is an enclosure; the smallest is returned."""
+    on grids REFINE times finer where a step's box is wider than the tube (the intervals'
+    excess falls as the square of a step's width; where the tube's radius is the wider, a
+    finer grid does not help) and the bound is above REFINE_CLOSE times the samples' guess
+    and above `negligible` (what the caller adds anyway: the integrator's floor), or infinite
+    while the guess is below REFINE_INF times `limit`. Every bound found is an enclosure; the
+    smallest is returned."""
     best = float("inf")
     for factor in REFINE:
         g = _bound_grid(values, m, factor)
@@ -1064,7 +1067,9 @@ def model_error(values: dict, m, limit: float = np.inf) -> float:
             break
         bound_, guess, wide = _model_error_on(values, g, min(limit, best))
         best = min(best, bound_)
-        if not (np.isfinite(guess) and wide) or best <= REFINE_CLOSE * guess:
+        if not (np.isfinite(guess) and wide) or best <= max(REFINE_CLOSE * guess, negligible):
+            break
+        if not np.isfinite(best) and not guess < REFINE_INF * limit:
             break
     return best
 
@@ -1104,6 +1109,12 @@ def _model_error_on(values: dict, g, limit: float):
     return inf, guess_image, wide
 
 
+def _integration_floor(m) -> float:
+    """The integration term's floor (its tolerance on the angles carried to the image point,
+    times INTEGRATION_SAFETY): the least the bound adds to the model's term."""
+    return INTEGRATION_SAFETY * float(np.max((1 + m.x**2 + m.y**2) * (RTOL * (np.abs(m.alpha) + np.abs(m.beta)) + ATOL)))
+
+
 def integration_error(values: dict, m) -> float:
     """INTEGRATION_SAFETY times the largest of: the difference of the answer (Adams, rtol
     1e-12) from BDF at the same tolerance, from Adams at a LOOSE times looser one, and the
@@ -1111,7 +1122,7 @@ def integration_error(values: dict, m) -> float:
     + |beta|) + ATOL) (absolute): where the motion is small against the angles (a moment of
     1e-12 N m) every run agrees with the others to the last bit and none is more accurate than
     its tolerance on the state."""
-    d = float(np.max((1 + m.x**2 + m.y**2) * (RTOL * (np.abs(m.alpha) + np.abs(m.beta)) + ATOL)))
+    d = _integration_floor(m) / INTEGRATION_SAFETY
     for other in (simulate(values, m.t, m.level, multistep="bdf"), simulate(values, m.t, m.level, rtol_scale=LOOSE)):
         d = max(d, float(np.hypot(m.x - other.x, m.y - other.y).max()))
     return INTEGRATION_SAFETY * d
@@ -1125,7 +1136,7 @@ def bound(values: dict, m) -> float:
     scale = _scale(m)
     if not scale > 0:
         return float("inf")
-    model = 0.0 if m.level == "full" else model_error(values, m, limit=scale)
+    model = 0.0 if m.level == "full" else model_error(values, m, limit=scale, negligible=_integration_floor(m))
     if not model / scale < 1:  # no bound: the integrator's runs are not needed
         return float("inf")
     b = (model + integration_error(values, m)) / scale

@@ -34,7 +34,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from gyro import ode
+from gyro import intervals, ode
 from gyro.errors import ParameterError, finite_number
 from gyro.models import load
 
@@ -531,34 +531,34 @@ def image_error(a, b) -> float:
 #   + |G sigma| + |G d_l|, E(0) = |G B P(0)| (full starts on (13): w(0) = 0), mu the
 #   logarithmic norm of G DPhi G^-1 + G' G^-1 over the tube, L the norm of G DPhi G^-1;
 # - the error s - s_l within E + |G B P| on the sphere, the image point within rho^2 of it.
-# Every constant is the largest over the tube |G (s - s_l)| <= r about the level's motion
-# (the centre and the six axial points at radius r, with twice their spread as the
-# allowance for the rest of the ball) and over each step (the larger end plus the steps'
-# difference as the allowance between samples, plus a floor: FLOOR_ALLOWANCE). The radius
-# is closed by a bootstrap: the bound computed with the constants of radius r must come out below r, else r is raised;
-# a tube that reaches beta or alpha = +-90 deg, or no closing within BOOTSTRAP tries: the
-# level refuses (the bound is infinite).
+# Every constant is the largest over the tube |G (s - s_l)| <= r about the level's motion,
+# over each step of the bound's grid, ENCLOSED (gyro/intervals.py, `_enclosed_constants`): the
+# level's motion over a step is held in a box by an a priori enclosure (`_level_boxes`: if
+# s_k + [0, h] R(X) lies in X, R the level's rates over X, the motion stays in X); the full
+# state in that box widened by r / G_j per axis; the tube function (every piece the
+# constants need) evaluated in interval arithmetic over both boxes, outward rounded (the
+# cancelling residuals rho1, eta, sigma also by the centred form f(c) + J(X)(X - c)); the
+# constants from the interval matrices by closed forms (2 x 2 eigenvalues), Weyl's bound
+# with a verified eigenvalue of the midpoint, and norms of the entrywise magnitudes. No
+# sampled allowance, no floor. The radius is closed by a bootstrap: the bound computed with
+# the constants of radius r must come out below r, else r is raised; a tube that reaches
+# beta or alpha = +-90 deg, a step's motion not enclosed, or no closing within BOOTSTRAP
+# tries: the level refuses (the bound is infinite). Where the bound is far from the
+# samples' guess and a step's box is wider than the tube, the grid is refined (REFINE).
 # The integrator's term: the answer (Adams, rtol 1e-12) against an independent method (BDF
 # with Newton's iteration, same tolerance) and against Adams 100x looser, twice the larger.
 
 LOOSE = 100.0
 INTEGRATION_SAFETY = 2.0
 PER_RADIAN = 20  # samples of the bound's grid per radian of the fastest frame rate
-MAX_SAMPLES = 200_000  # a motion that needs more: the bound is not evaluated (infinite)
-MIN_SAMPLES = 41  # the bound's grid has at least these
+MAX_SAMPLES = 50_000  # a motion that needs more: the bound is not evaluated (infinite; the intervals' cost)
+MIN_SAMPLES = 401  # the bound's grid has at least these
+REFINE = (1, 4)  # the bound's grid: these times finer in turn, while the bound is far from its guess
+REFINE_CLOSE = 2.0  # a bound within this factor of the samples' guess: no finer grid
+REFINE_MAX_SAMPLES = 5_000  # a refined grid no longer than this (its cost)
+REFINE_INF = 1e-3  # a refused set is tried on a finer grid only where its guess is below this of the limit
 BOOTSTRAP = 6  # tries to close the tube's radius
 TUBE_GROWTH = 2.0  # a try that does not close raises the radius to this times its bound
-BALL_ALLOWANCE = 2.0  # the tube's constant: the centre's plus this times the axial points' spread
-# and each step's plus this times the constant's largest magnitude over the horizon; |rho1|, second
-# order and computed with cancellation, also RHO1_FLOOR times |rho0|'s largest (measured, `python -m
-# bench.precession_bounds 11 --allowances 16`: random points of the ball and a 4x denser grid
-# exceeded the sampled maxima by 3e-7 of that magnitude (|rho1|) where the tube's radius is 1e-10
-# rad or more, 2e-5 at 1e-20..1e-10 rad (|rho1| 0.97, where it is 1e-7..1e-5 of |rho0|), none
-# with the floors; 0.98 on motions of rounding size, a model term of 1e-26 against the
-# integrator's 1e-12)
-FLOOR_ALLOWANCE = 1e-2
-RHO1_FLOOR = 1e-4
-
 
 def _scale(m) -> float:
     return float(np.hypot(m.x - m.x[0], m.y - m.y[0]).max())
@@ -659,20 +659,7 @@ def _tube_function():
 
 def _at(values: dict, S: np.ndarray) -> dict:
     """The tube function at the states S (n, 3), unpacked (each (n, ...))."""
-    col = np.array(_tube_function()(vector(values), S.T)).T
-    shapes = {"Phi": (3,), "DPhi": (3, 3), "rho1": (2,), "Q": (2, 2), "Mr": (2, 2), "eta": (2,), "BKM": (3, 2),
-              "Dpi": (3, 3), "sigma": (3,), "s1": (3, 2), "s2": (3, 2, 2), "rho0": (2,)}
-    out, k = {}, 0
-    for name, shape in shapes.items():
-        size = int(np.prod(shape))
-        block = col[:, k:k + size]
-        if len(shape) == 2:  # CasADi's vec is column-major
-            block = block.reshape(-1, shape[1], shape[0]).transpose(0, 2, 1)
-        elif len(shape) == 3:
-            block = block.reshape(-1, shape[0], shape[2], shape[1]).transpose(0, 1, 3, 2)
-        out[name] = block.reshape((-1, *shape))
-        k += size
-    return out
+    return _unpack(np.array(_tube_function()(vector(values), S.T)).T)
 
 
 def _norm2(A):
@@ -698,60 +685,21 @@ def _constants(c: dict, Gd: np.ndarray, Gdot: np.ndarray, kappa: np.ndarray) -> 
             "s2": np.sqrt(np.sum((Gd[:, :, None, None] * c["s2"])**2, axis=(1, 2, 3)))}
 
 
-def _over_tube(values, S, own, Gd, Gdot, kappa, r) -> dict:
-    """Each constant's largest over the tube of radius r about the states S: the centre's
-    plus BALL_ALLOWANCE times the largest spread of the six axial points (for mmin the
-    smallest, the same way); then over each step: the larger end plus the ends' difference,
-    plus FLOOR_ALLOWANCE times its largest magnitude over the horizon (|rho1| also RHO1_FLOOR
-    times |rho0|'s largest).
-    Returns per step (n - 1); `own` the tube function at S."""
-    centre = _constants(own, Gd, Gdot, kappa)
-    if r > 0:
-        spread = {k: np.zeros_like(v) for k, v in centre.items()}
-        for j in range(3):
-            for sign in (-1.0, 1.0):
-                Sj = S.copy()
-                Sj[:, j] += sign * r / Gd[:, j]
-                cj = _constants(_at(values, Sj), Gd, Gdot, kappa)
-                for k in centre:
-                    spread[k] = np.maximum(spread[k], np.abs(cj[k] - centre[k]))
-        tube = {k: centre[k] + BALL_ALLOWANCE * spread[k] for k in centre}
-        tube["mmin"] = centre["mmin"] - BALL_ALLOWANCE * spread["mmin"]
-    else:
-        tube = centre
-    step = {}
-    for k, v in tube.items():
-        a, b = v[:-1], v[1:]
-        floor = FLOOR_ALLOWANCE * float(np.max(np.abs(v)))
-        if k == "rho":
-            floor += RHO1_FLOOR * float(np.max(tube["rho0"]))
-        step[k] = (np.minimum(a, b) - np.abs(b - a) - floor) if k == "mmin" else (np.maximum(a, b) + np.abs(b - a) + floor)
-    return step
-
-
-def _level_defect(values: dict, m) -> np.ndarray:
-    """(n, 3): d_l = Phi(s_l) - s_l', the rates of (13) minus the level's at the level's own
-    state, in alpha', beta', H' (0 for rigorous and image: (21) is (13) in x, y exactly)."""
-    if m.level not in ("small", "elementary"):
-        return np.zeros((len(m.t), 3))
-    nf = load(MODEL).numpy
-    P = vector(values)
-    xy, Hs = np.stack([m.x, m.y], axis=-1), m.H[:, None]
-    d = _solve_rows(*nf.image_system(P, xy, Hs)) - _solve_rows(*getattr(nf, f"{m.level}_system")(P, xy, Hs))
-    da, db = _image_to_angle_rates(m.x, m.y, d[:, 0], d[:, 1])
-    return np.stack([da, db, d[:, 2]], axis=-1)
-
-
-def _bound_grid(values: dict, m):
+def _bound_grid(values: dict, m, factor: int = 1):
     """The level's motion on a grid with PER_RADIAN samples per radian of the fastest frame
     rate (the base's |u| plus the largest |alpha'| + |beta'| of (13) on m), at least
-    MIN_SAMPLES: m's own samples, thinned, where it is denser; None where that takes more
-    than MAX_SAMPLES."""
+    MIN_SAMPLES, both times `factor` (a refined grid: the level integrated again with those
+    output times); m's own samples, thinned, where it is denser; None where that takes more
+    than MAX_SAMPLES (REFINE_MAX_SAMPLES for a refined grid)."""
     P = vector(values)
     r3 = _rigorous(P, m.alpha, m.beta, m.H)
     u = float(np.linalg.norm([values[b] for b in BASE]))
     w = u + float(np.max(np.abs(r3[:, 0]) + np.abs(r3[:, 1])))
     n = int(np.ceil(float(m.t[-1]) * w * PER_RADIAN)) + 1
+    if factor > 1:
+        n = (max(n, MIN_SAMPLES, len(m.t)) - 1) * factor + 1
+        if n > REFINE_MAX_SAMPLES:
+            return None
     if n > MAX_SAMPLES:
         return None
     if n > len(m.t):
@@ -766,72 +714,405 @@ def _bound_grid(values: dict, m):
 EDGE = float(np.arccos(SINGULAR_COS))  # a tube past this angle reaches the singularity
 
 
-def _enclosure(values: dict, g, own: dict, r: float, limit: float = np.inf):
-    """(the largest |P_level - P_full| over the horizon, the largest |G (s - s_l)|) with the
-    tube constants of radius r (see above); inf where the tube reaches +-90 deg, or where
-    |G (s - s_l)| reaches `limit` (the image point's error is at least that: rho^2 >= 1)."""
-    H0 = abs(float(values["H"]))
+@lru_cache(maxsize=4)
+def _level_function(level: str):
+    """A CasADi Function of (p, s), s = (alpha, beta, H), giving the level's own rates in
+    alpha', beta', H' (3) and d_l = Phi(s) - those rates (3): 0 for rigorous and image ((21)
+    is (13) in x, y exactly); for small and elementary the difference of (21)'s rates from
+    theirs at the same image point, carried to the angle rates (one expression, so that
+    its centred interval form sees the cancellation)."""
+    import casadi as ca
+
+    cf = load(MODEL).casadi
+    e = _expressions()
+    p, s = e["p"], e["s"]
+    Phi = ca.substitute(ca.substitute(e["Phi"], e["w"], ca.DM.zeros(2)), e["o"], ca.DM.zeros(2))
+    if level not in ("small", "elementary"):
+        return ca.Function(f"rates_{level}", [p, s], [ca.vertcat(Phi, ca.DM.zeros(3))], {"cse": True})
+    xy = cf.image_point(p, s[:2])
+    d = ca.solve(*cf.image_system(p, xy, s[2])) - ca.solve(*getattr(cf, f"{level}_system")(p, xy, s[2]))
+    x, y = xy[0], xy[1]
+    r2 = 1 + y**2
+    q = x / ca.sqrt(r2)
+    dq = d[0] / ca.sqrt(r2) - x * y * d[1] / (r2 * ca.sqrt(r2))
+    dl = ca.vertcat(-d[1] / r2, dq / (1 + q**2), d[2])  # (alpha, beta) of the image point's rates
+    return ca.Function(f"rates_{level}", [p, s], [ca.vertcat(Phi - dl, dl)], {"cse": True})
+
+
+@lru_cache(maxsize=4)
+def _level_jacobian(level: str):
+    return intervals.jacobian_function(_level_function(level), 1)
+
+
+def _level_rates(values: dict, level: str, lo, hi):
+    """Intervals (lo, hi) of the level's rates and of d_l over the boxes [lo, hi] (n, 3) of
+    its state (the centred form: d_l is a small difference of near-equal rates)."""
+    P = vector(values)
+    (rl, rh), = intervals.centred(_level_function(level), _level_jacobian(level), 1, [(P, P), (lo.T, hi.T)])
+    return (rl[:3].T, rh[:3].T), (rl[3:].T, rh[3:].T)
+
+
+LEVEL_BOX_TRIES = 8  # the a priori enclosure of the level's motion over a step: tries
+
+
+def _level_boxes(values: dict, g):
+    """Per step of the grid g, a box (lo, hi) (n - 1, 3) in (alpha, beta, H) that holds the
+    level's motion over the step (the flow from the step's first sample and its last
+    sample), and the intervals of its rates and of d_l over it; None where a step's box
+    is not found. A priori enclosure: if s_k + [0, h] R(X) lies in X, R(X) the rates'
+    interval over X, the flow from s_k stays in X over the step (it cannot leave X first:
+    until then its rates are in R(X)). X starts as the hull of the two samples, then
+    grows to the candidate found, half as wide again."""
     S = np.stack([g.alpha, g.beta, g.H], axis=-1)
-    cb = np.cos(g.beta)
-    if np.any(np.abs(g.beta) + r >= EDGE) or np.any(np.abs(g.alpha) + r / np.abs(cb) >= EDGE):
-        return float("inf"), float("inf")
-    Gd = np.stack([np.abs(cb), np.ones_like(cb), np.full_like(cb, 1 / H0)], axis=-1)
-    dl = _level_defect(values, g)
-    rate = own["Phi"] - dl  # the level's own rates, in alpha', beta', H'
-    Gdot = np.stack([-np.tan(g.beta) * rate[:, 1], np.zeros_like(cb), np.zeros_like(cb)], axis=-1)
-    kappa = np.einsum("nij,nj->ni", own["Dpi"], rate)  # the nutation centre's drift along the level
-    c = _over_tube(values, S, own, Gd, Gdot, kappa, r)
-    if not all(np.all(np.isfinite(x)) for x in c.values()) or not (np.all(c["mmin"] > 0) and np.all(c["Lpi"] < 1)):
-        return float("inf"), float("inf")
-    dn = np.linalg.norm(Gd * dl, axis=-1)
-    dstep = np.maximum(dn[:-1], dn[1:]) + np.abs(dn[1:] - dn[:-1])
-    h = np.diff(g.t)
-    W = float(np.sqrt(own["eta"][0] @ own["Mr"][0] @ own["eta"][0]))  # w(0) = 0 (full starts on (13)):
-    # om(0) = -eta(s(0)), the full state at t = 0 the level's; delta(0) = 0
+    a, b = S[:-1], S[1:]
+    h = intervals.up(np.diff(g.t))[:, None]  # the step lengths, rounded up
+    lo = np.minimum(a, b)
+    hi = np.maximum(a, b)
+    pad = (hi - lo) / 4 + 1e-12 * (1 + np.abs(a))
+    lo, hi = lo - pad, hi + pad
+    done = np.zeros(len(a), bool)
+    for _ in range(LEVEL_BOX_TRIES):
+        todo = np.flatnonzero(~done)
+        if not todo.size:
+            break
+        (Rl, Rh), _ = _level_rates(values, g.level, lo[todo], hi[todo])
+        ylo = np.minimum(intervals.down(a[todo] + intervals.down(h[todo] * Rl)), a[todo])
+        yhi = np.maximum(intervals.up(a[todo] + intervals.up(h[todo] * Rh)), a[todo])
+        ylo, yhi = np.minimum(ylo, b[todo]), np.maximum(yhi, b[todo])
+        if not (np.all(np.isfinite(ylo)) and np.all(np.isfinite(yhi))):  # rates not enclosed: refused
+            return None
+        inside = np.all((ylo >= lo[todo]) & (yhi <= hi[todo]), axis=-1)
+        good = todo[inside]
+        lo[good], hi[good] = ylo[inside], yhi[inside]
+        done[good] = True
+        bad = todo[~inside]
+        grow = (yhi[~inside] - ylo[~inside]) / 4 + 1e-12 * (1 + np.abs(a[bad]))
+        lo[bad] = np.minimum(lo[bad], ylo[~inside] - grow)
+        hi[bad] = np.maximum(hi[bad], yhi[~inside] + grow)
+    if not np.all(done) or not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+        return None
+    rates_, dl = _level_rates(values, g.level, lo, hi)  # over the box found (the motion is in it)
+    return (lo, hi), rates_, dl
+
+
+_SHAPES = {"Phi": (3,), "DPhi": (3, 3), "rho1": (2,), "Q": (2, 2), "Mr": (2, 2), "eta": (2,), "BKM": (3, 2),
+           "Dpi": (3, 3), "sigma": (3,), "s1": (3, 2), "s2": (3, 2, 2), "rho0": (2,)}
+
+
+def _unpack(col: np.ndarray) -> dict:
+    """The tube function's column (n, 62), unpacked by _SHAPES (each (n, ...))."""
+    out, k = {}, 0
+    for name, shape in _SHAPES.items():
+        size = int(np.prod(shape))
+        block = col[:, k:k + size]
+        if len(shape) == 2:  # CasADi's vec is column-major
+            block = block.reshape(-1, shape[1], shape[0]).transpose(0, 2, 1)
+        elif len(shape) == 3:
+            block = block.reshape(-1, shape[0], shape[2], shape[1]).transpose(0, 1, 3, 2)
+        out[name] = block.reshape((-1, *shape))
+        k += size
+    return out
+
+
+CANCELLING = ("rho1", "eta", "sigma")  # small differences of large terms: the centred form's
+
+
+@lru_cache(maxsize=1)
+def _cancelling_function():
+    """The tube function's pieces CANCELLING (rho1: second order; eta and sigma: the first-order
+    defect, a residual of the full equations), as a Function of (p, s), and its Jacobian in s."""
+    import casadi as ca
+
+    f = _tube_function()
+    p, s = ca.SX.sym("p", f.sparsity_in(0)), ca.SX.sym("s", f.sparsity_in(1))
+    col = f(p, s)
+    k, pick = 0, []
+    for name, shape in _SHAPES.items():
+        size = int(np.prod(shape))
+        if name in CANCELLING:
+            pick.append(col[k:k + size])
+        k += size
+    fun = ca.Function("precession_cancelling", [p, s], [ca.vertcat(*pick)], {"cse": True})
+    return fun, intervals.jacobian_function(fun, 1)
+
+
+def _tube_intervals(values: dict, lo, hi) -> dict:
+    """Each piece of the tube function as an interval (lo, hi) over the boxes [lo, hi]
+    (n, 3): for every state in a box, its value is inside (gyro.intervals): the natural
+    interval extension, and for the pieces CANCELLING the centred form (f(c) + J(X) (X - c)),
+    whose excess is of the square of the box's width where the natural one's is of the width."""
+    P = vector(values)
+    (clo, chi), = intervals.evaluate(_tube_function(), [(P, P), (lo.T, hi.T)])
+    L, H = _unpack(clo.T), _unpack(chi.T)
+    fun, jac = _cancelling_function()
+    (flo, fhi), = intervals.centred(fun, jac, 1, [(P, P), (lo.T, hi.T)], natural=False)
+    k = 0
+    for name in CANCELLING:
+        size = int(np.prod(_SHAPES[name]))
+        L[name] = np.maximum(L[name], flo[k:k + size].T.reshape(L[name].shape))
+        H[name] = np.minimum(H[name], fhi[k:k + size].T.reshape(H[name].shape))
+        k += size
+    return {k: (L[k], H[k]) for k in L}
+
+
+def _imul(a, b):
+    return intervals._mul(a, b)
+
+
+def _matvec(A, x):
+    """Interval matrix (n, i, j) times interval vector (n, j): (n, i)."""
+    out = None
+    for j in range(A[0].shape[-1]):
+        t = _imul((A[0][..., j], A[1][..., j]), (x[0][:, None, j], x[1][:, None, j]))
+        out = t if out is None else intervals._add(out, t)
+    return out
+
+
+def _scale_rows_cols(G, A, cols=True):
+    """G_i A_ij / G_j (or G_i A_ij with cols False) over intervals, G (n, 3) intervals."""
+    r = _imul((G[0][:, :, None], G[1][:, :, None]), A)
+    if not cols:
+        return r
+    return intervals._div(r, (G[0][:, None, :], G[1][:, None, :]))
+
+
+def _enclosed_constants(values: dict, box, rates_, dl, r: float, start) -> dict:
+    """The enclosure's constants (docs/precession.md, steps 2-4) over each step: the largest
+    (for mmin the smallest) over every time of the step and every state of the tube
+    |G (s - s_l)| <= r about it, from interval evaluations: the level's box `box` (n - 1, 3)
+    for G, G' G^-1 and kappa = D pi(s_l) s_l', the box widened by r / G_j per axis (G_j's
+    smallest over the step) for the full state's pieces. Each a number per step; "W0" an
+    upper bound of Omega(0) = |eta(s(0))|_Mr at the start `start` (1, 3), a point."""
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # inf and NaN mean refused, below
+        return _enclosed_constants_of(values, box, rates_, dl, r, start)
+
+
+def _enclosed_constants_of(values: dict, box, rates_, dl, r: float, start) -> dict:
+    iv = intervals
+    lo, hi = box
+    H0 = abs(float(values["H"]))
+    cb = iv._fabs(iv._cos((lo[:, 1], hi[:, 1])))  # |cos beta_l| over the step
+    if not np.all(cb[0] > 0):
+        return None
+    n = len(lo)
+    ones = np.ones(n)
+    inv_h = (iv.down(1 / H0) * ones, iv.up(1 / H0) * ones)
+    G = (np.stack([cb[0], ones, inv_h[0]], -1), np.stack([cb[1], ones, inv_h[1]], -1))
+    reach = np.stack([iv.up(r / cb[0]), np.full(n, r), np.full(n, iv.up(r * H0))], -1)
+    both = _tube_intervals(values, np.vstack([iv.down(lo - reach), lo, start]), np.vstack([iv.up(hi + reach), hi, start]))
+    tube = {k: (x[0][:n], x[1][:n]) for k, x in both.items()}
+    own = {k: (x[0][n:2 * n], x[1][n:2 * n]) for k, x in both.items()}
+    at0 = {k: (x[0][2 * n:], x[1][2 * n:]) for k, x in both.items()}
+    # G' G^-1 = diag(-tan(beta_l) beta_l', 0, 0); kappa = D pi(s_l) s_l' (the level's own rates)
+    gdot = iv._neg(_imul(iv._tan((lo[:, 1], hi[:, 1])), (rates_[0][:, 1], rates_[1][:, 1])))
+    kappa = _matvec(own["Dpi"], rates_)
+
+    Mr, Q = tube["Mr"], tube["Q"]
+    m11, m22 = (Mr[0][:, 0, 0], Mr[1][:, 0, 0]), (Mr[0][:, 1, 1], Mr[1][:, 1, 1])
+    m12 = (np.maximum(Mr[0][:, 0, 1], Mr[0][:, 1, 0]), np.minimum(Mr[1][:, 0, 1], Mr[1][:, 1, 0]))  # Mr symmetric
+    q11, q22 = (Q[0][:, 0, 0], Q[1][:, 0, 0]), (Q[0][:, 1, 1], Q[1][:, 1, 1])
+    q12 = iv._mul(iv._add((Q[0][:, 0, 1], Q[1][:, 0, 1]), (Q[0][:, 1, 0], Q[1][:, 1, 0])), (0.5, 0.5))
+    det_m = iv._sub(iv._mul(m11, m22), iv._sq(m12))
+    Msym = (np.stack([np.stack([m11[0], m12[0]], -1), np.stack([m12[0], m22[0]], -1)], -2),
+            np.stack([np.stack([m11[1], m12[1]], -1), np.stack([m12[1], m22[1]], -1)], -2))
+    mmin = iv.lambda_min_lower(*Msym)
+    # lambda: the largest root of det(Q - lambda Mr) = 0, det(Mr) l^2 - bq l + det(Q) = 0
+    bq = iv._sub(iv._add(iv._mul(q11, m22), iv._mul(q22, m11)), iv._twice(iv._mul(q12, m12)))
+    disc = iv._sub(iv._sq(bq), iv._mul((4.0, 4.0), iv._mul(det_m, iv._sub(iv._mul(q11, q22), iv._sq(q12)))))
+    disc = (np.maximum(disc[0], 0.0), disc[1])  # real roots: the true discriminant is >= 0
+    lam = iv._div(iv._add(bq, iv._sqrt(disc)), iv._twice(det_m))[1]
+    # |rho1|_Mr^-1 = sqrt(rho1.adj(Mr) rho1 / det Mr)
+    r1, r2 = (tube["rho1"][0][:, 0], tube["rho1"][1][:, 0]), (tube["rho1"][0][:, 1], tube["rho1"][1][:, 1])
+    quad = iv._add(iv._sub(iv._mul(m22, iv._sq(r1)), iv._twice(iv._mul(m12, iv._mul(r1, r2)))), iv._mul(m11, iv._sq(r2)))
+    rho = iv.up(np.sqrt(np.maximum(iv._div(quad, det_m)[1], 0.0)))
+    rho = np.where(det_m[0] > 0, rho, np.inf)
+
+    GD = _scale_rows_cols(G, tube["DPhi"])
+    Wlo = (GD[0] + np.swapaxes(GD[0], 1, 2)) / 2
+    Whi = (GD[1] + np.swapaxes(GD[1], 1, 2)) / 2
+    Wlo, Whi = iv.down(Wlo), iv.up(Whi)
+    Wlo[:, 0, 0] = iv.down(Wlo[:, 0, 0] + gdot[0])
+    Whi[:, 0, 0] = iv.up(Whi[:, 0, 0] + gdot[1])
+    sig = iv._sub(tube["sigma"], kappa)
+    dlG = _imul(G, dl)
+    return {"lam": lam, "rho": rho, "mmin": mmin,
+            "eta": iv.norm_upper(iv.mag(tube["eta"]), (1,)),
+            "mu": iv.lambda_max_upper(Wlo, Whi), "L": iv.norm2_upper(iv.mag(GD)),
+            "PK": iv.norm2_upper(iv.mag(_scale_rows_cols(G, tube["BKM"], cols=False))),
+            "Lpi": iv.norm2_upper(iv.mag(_scale_rows_cols(G, tube["Dpi"]))),
+            "chi": iv.norm_upper(iv.mag(_imul(G, sig)), (1,)),
+            "s1": iv.norm2_upper(iv.mag(_scale_rows_cols(G, tube["s1"], cols=False))),
+            "s2": iv.norm_upper(iv.mag(_imul((G[0][:, :, None, None], G[1][:, :, None, None]), tube["s2"])), (1, 2, 3)),
+            "dl": iv.norm_upper(iv.mag(dlG), (1,)), "W0": _energy_norm(at0["eta"], at0["Mr"])}
+
+
+def _constants_at(values: dict, level: str, SL: np.ndarray, S: np.ndarray, own_l: dict | None = None,
+                  own: dict | None = None) -> dict:
+    """The constants at the level's states SL (n, 3) (its metric G, G' G^-1, kappa, d_l) and
+    the full states S (n, 3) (the tube's pieces), points: what `_enclosed_constants` holds
+    over a step's box and its tube; `own_l`, `own` the tube function at SL, S if at hand."""
+    P, H0 = vector(values), abs(float(values["H"]))
+    own_l = _at(values, SL) if own_l is None else own_l
+    own = _at(values, S) if own is None else own
+    out = np.array(_level_function(level)(P, SL.T)).T
+    rate, dl = out[:, :3], out[:, 3:]
+    cb = np.cos(SL[:, 1])
+    Gd = np.stack([np.abs(cb), np.ones_like(cb), np.full_like(cb, 1 / H0)], -1)
+    Gdot = np.stack([-np.tan(SL[:, 1]) * rate[:, 1], np.zeros_like(cb), np.zeros_like(cb)], -1)
+    c = _constants(own, Gd, Gdot, np.einsum("nij,nj->ni", own_l["Dpi"], rate))
+    c["dl"] = np.linalg.norm(Gd * dl, axis=-1)
+    return c
+
+
+def _point_constants(values: dict, g, own: dict) -> dict:
+    """The constants at the grid's samples (no tube), per step the larger end (the smaller
+    for mmin): a first guess of the tube's radius only, never a bound."""
+    S = np.stack([g.alpha, g.beta, g.H], axis=-1)
+    c = _constants_at(values, g.level, S, S, own, own)
+    return {k: np.maximum(v[:-1], v[1:]) if k != "mmin" else np.minimum(v[:-1], v[1:]) for k, v in c.items()}
+
+
+def _energy_norm(eta, Mr) -> float:
+    """An upper bound of sqrt(eta.Mr eta) over one box's intervals (1, 2), (1, 2, 2)."""
+    q = None
+    for i in range(2):
+        for j in range(2):
+            t = _imul(_imul((eta[0][:, i], eta[1][:, i]), (Mr[0][:, i, j], Mr[1][:, i, j])), (eta[0][:, j], eta[1][:, j]))
+            q = t if q is None else intervals._add(q, t)
+    return float(intervals.up(np.sqrt(max(float(q[1][0]), 0.0))))
+
+
+ROUNDING_GROWTH = 32  # the recurrences' floating-point error: (1 + eps)^(32 n) over n steps (below)
+
+
+def _propagate(c: dict, h: np.ndarray, W0: float, limit: float, rigorous: bool):
+    """Steps 2-4 integrated as upper solutions over the grid with the per-step constants c:
+    the largest |G (s - s_l)| over the horizon (inf where it reaches `limit`, overflows, or
+    mmin <= 0 or l_pi >= 1). With `rigorous`, the result is raised by (1 + eps)^(32 n) - 1
+    relative: the exponents, 1/(1 - l_pi) and sqrt(m) are rounded outward, and every other
+    quantity of the loop is >= 0, with fewer than 32 roundings per step (each at most eps
+    relative) on the way to the next."""
+    if not all(np.all(~np.isnan(x)) for x in c.values()) or not (np.all(c["mmin"] > 0) and np.all(c["Lpi"] < 1)):
+        return float("inf")
     E = worst = 0.0
-    k1 = 1 / (1 - c["Lpi"])
+    W = W0
+    up, down = intervals.up, intervals.down
+    k1 = up(1 / down(1 - c["Lpi"]))
     with np.errstate(over="ignore", invalid="ignore"):  # an overflow is refused below, not warned
-        gl = np.exp(c["lam"] * h)
-        gm = np.exp((c["mu"] + c["L"] * c["Lpi"] * k1) * h)
+        # the exponents rounded up (mu may be negative: a signed sum), the rest nonnegative
+        gl = up(np.exp(up(c["lam"] * h)), intervals.TRANSCENDENTAL_ULPS)
+        gm = up(np.exp(up(up(c["mu"] + up(up(c["L"] * c["Lpi"]) * k1)) * h)), intervals.TRANSCENDENTAL_ULPS)
+        sq = down(np.sqrt(c["mmin"]))
         for k in range(len(h)):
             Wsup = (W + h[k] * c["rho"][k]) * max(1.0, gl[k])  # |w|_Mr over the step
             W = W * gl[k] + h[k] * c["rho"][k] * max(1.0, gl[k])
-            wmax = c["eta"][k] + Wsup / np.sqrt(c["mmin"][k])  # |w| <= |eta| + |om| over the step
+            wmax = c["eta"][k] + Wsup / sq[k]  # |w| <= |eta| + |om| over the step
             F = (c["L"][k] * c["PK"][k] * k1[k] * wmax + c["s1"][k] * wmax + c["s2"][k] * wmax**2 / 2
-                 + c["chi"][k] + dstep[k])
+                 + c["chi"][k] + c["dl"][k])
             Esup = (E + h[k] * F) * max(1.0, gm[k])
             E = E * gm[k] + h[k] * F * max(1.0, gm[k])
             here = (Esup + c["PK"][k] * wmax) * k1[k]  # |G (s - s_l)| over the step
             if not here < limit:  # an overflow (inf, or inf * 0), or past the limit: no enclosure worth offering
-                return float("inf"), float("inf")
+                return float("inf")
             worst = max(worst, here)
-    # the sphere's distance within max(1, cos beta / cos beta_l) |G e| over the tube, the image
-    # point within rho^2 of it (the gnomonic projection's largest scale), both largest over the tube
-    cos_b = np.cos(np.maximum(np.abs(g.beta) - worst, 0.0)) / np.abs(cb)
-    c_far = np.cos(np.abs(g.alpha) + worst / np.abs(cb)) * np.cos(np.abs(g.beta) + worst)
-    if np.any(c_far <= SINGULAR_COS) or np.any(np.abs(g.beta) + worst >= EDGE):
-        return float("inf"), worst
-    return float(np.max(np.maximum(1.0, cos_b) / c_far**2) * worst), worst
+    if rigorous:
+        worst *= 1 + ROUNDING_GROWTH * (len(h) + 1) * 2 * intervals.EPS
+    return worst if worst < limit else float("inf")
 
 
-def model_error(values: dict, m, limit: float = np.inf) -> float:
-    """The enclosure of the largest |P_level - P_full| over the horizon (absolute; the
-    derivation above); inf where the level refuses: the tube does not close within BOOTSTRAP
-    tries, reaches +-90 deg, or the grid would be too fine; inf also where a try's bound
-    reaches `limit` (a bound no use: the caller's relative bound would be >= 1)."""
-    g = _bound_grid(values, m)
-    if g is None:
+def _image_bound(g, box, worst: float) -> float:
+    """Step 5: the image point's error from the largest |G e| over the horizon, over each
+    step's box of the level's state: the arc on the sphere within max(1, cos beta /
+    |cos beta_l|) |G e|, the image point within rho^2 = 1/(cos alpha cos beta)^2 of it;
+    inf where the tube reaches +-90 deg. Rounded up: the cosines within 1e-12 relative
+    (a few roundings, each far below, where |cos| >= 1e-3)."""
+    lo, hi = box
+    aa = np.maximum(np.abs(lo[:, 0]), np.abs(hi[:, 0]))
+    ba = np.maximum(np.abs(lo[:, 1]), np.abs(hi[:, 1]))
+    bmin = np.where(lo[:, 1] * hi[:, 1] <= 0, 0.0, np.minimum(np.abs(lo[:, 1]), np.abs(hi[:, 1])))
+    cbl = np.cos(ba) * (1 - 1e-12)  # the smallest |cos beta_l| over the step
+    if np.any(ba + worst >= EDGE) or np.any(cbl <= SINGULAR_COS) or np.any(aa + worst / cbl >= EDGE):
         return float("inf")
+    cos_b = np.cos(np.maximum(bmin - worst, 0.0)) * (1 + 1e-12) / cbl
+    c_far = np.cos(aa + worst / cbl) * np.cos(ba + worst) * (1 - 1e-12)
+    if np.any(c_far <= SINGULAR_COS):
+        return float("inf")
+    return float(np.max(np.maximum(1.0, cos_b) / c_far**2) * worst * (1 + 1e-12))
+
+
+def _guess(values: dict, g, own: dict, limit: float = np.inf) -> float:
+    """The largest |G (s - s_l)| with the constants at the grid's samples and no tube: the
+    first radius of the bootstrap, never a bound; `own` the tube function at the samples."""
+    c = _point_constants(values, g, own)
+    W0 = float(np.sqrt(own["eta"][0] @ own["Mr"][0] @ own["eta"][0]))
+    return _propagate(c, np.diff(g.t), W0, limit, rigorous=False)
+
+
+def model_error(values: dict, m, limit: float = np.inf, negligible: float = 0.0) -> float:
+    """The enclosure of the largest |P_level - P_full| over the horizon (absolute; the
+    derivation above); inf where the level refuses: the level's motion over a step is not
+    enclosed, the tube does not close within BOOTSTRAP tries, reaches +-90 deg, or the grid
+    would be too fine; inf also where a try's bound reaches `limit` (a bound no use: the
+    caller's relative bound would be >= 1). On the grid of PER_RADIAN samples per radian, then
+    on grids REFINE times finer where a step's box is wider than the tube (the intervals'
+    excess falls as the square of a step's width; where the tube's radius is the wider, a
+    finer grid does not help) and the bound is above REFINE_CLOSE times the samples' guess
+    and above `negligible` (what the caller adds anyway: the integrator's floor), or infinite
+    while the guess is below REFINE_INF times `limit`. Every bound found is an enclosure; the
+    smallest is returned."""
+    best = float("inf")
+    for factor in REFINE:
+        g = _bound_grid(values, m, factor)
+        if g is None:
+            break
+        bound_, guess, wide = _model_error_on(values, g, min(limit, best))
+        best = min(best, bound_)
+        if not (np.isfinite(guess) and wide) or best <= max(REFINE_CLOSE * guess, negligible):
+            break
+        if not np.isfinite(best) and not guess < REFINE_INF * limit:
+            break
+    return best
+
+
+def _model_error_on(values: dict, g, limit: float):
+    """(the enclosure on the grid g, the guess's image bound, whether a step's box is wider
+    than the guessed tube in alpha or beta): the first radius is a guess
+    from the constants at the samples; each try's constants are enclosed over the tube of
+    that radius (`_enclosed_constants`), and the tube is closed where the bound they give is
+    below it."""
+    inf = float("inf")
     own = _at(values, np.stack([g.alpha, g.beta, g.H], axis=-1))
-    r = 0.0
+    guess = _guess(values, g, own, limit)
+    if not np.isfinite(guess):
+        return inf, inf, False
+    lb = _level_boxes(values, g)
+    if lb is None:
+        return inf, inf, False
+    box, rates_, dl = lb
+    guess_image = _image_bound(g, box, guess)
+    r = TUBE_GROWTH * guess + 1e-300
+    wide = bool(np.max(box[1][:, :2] - box[0][:, :2]) > r)
+    h = intervals.up(np.diff(g.t))
+    start = np.array([[g.alpha[0], g.beta[0], g.H[0]]])
     for _ in range(BOOTSTRAP):
-        err, worst = _enclosure(values, g, own, r, limit)
+        if np.any(np.maximum(np.abs(box[0][:, 1]), np.abs(box[1][:, 1])) + r >= EDGE):
+            return inf, guess_image, wide
+        c = _enclosed_constants(values, box, rates_, dl, r, start)
+        if c is None:
+            return inf, guess_image, wide
+        worst = _propagate(c, h, c.pop("W0"), limit, rigorous=True)
         if not np.isfinite(worst):
-            return float("inf")
+            return inf, guess_image, wide
         if worst < r:  # closed: the tube of radius r holds the full motion over the horizon
-            return err
+            return _image_bound(g, box, worst), guess_image, wide
         r = TUBE_GROWTH * worst
-    return float("inf")
+    return inf, guess_image, wide
+
+
+def _integration_floor(m) -> float:
+    """The integration term's floor (its tolerance on the angles carried to the image point,
+    times INTEGRATION_SAFETY): the least the bound adds to the model's term."""
+    return INTEGRATION_SAFETY * float(np.max((1 + m.x**2 + m.y**2) * (RTOL * (np.abs(m.alpha) + np.abs(m.beta)) + ATOL)))
 
 
 def integration_error(values: dict, m) -> float:
@@ -841,7 +1122,7 @@ def integration_error(values: dict, m) -> float:
     + |beta|) + ATOL) (absolute): where the motion is small against the angles (a moment of
     1e-12 N m) every run agrees with the others to the last bit and none is more accurate than
     its tolerance on the state."""
-    d = float(np.max((1 + m.x**2 + m.y**2) * (RTOL * (np.abs(m.alpha) + np.abs(m.beta)) + ATOL)))
+    d = _integration_floor(m) / INTEGRATION_SAFETY
     for other in (simulate(values, m.t, m.level, multistep="bdf"), simulate(values, m.t, m.level, rtol_scale=LOOSE)):
         d = max(d, float(np.hypot(m.x - other.x, m.y - other.y).max()))
     return INTEGRATION_SAFETY * d
@@ -855,7 +1136,7 @@ def bound(values: dict, m) -> float:
     scale = _scale(m)
     if not scale > 0:
         return float("inf")
-    model = 0.0 if m.level == "full" else model_error(values, m, limit=scale)
+    model = 0.0 if m.level == "full" else model_error(values, m, limit=scale, negligible=_integration_floor(m))
     if not model / scale < 1:  # no bound: the integrator's runs are not needed
         return float("inf")
     b = (model + integration_error(values, m)) / scale

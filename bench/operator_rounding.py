@@ -8,8 +8,9 @@ draw), the gyrohorizoncompass also at its sets near epsilon0 = 89.99 deg: how ma
 each beats, and the enclosure's ratio bound / actual (median, max) over the entries with an
 error. Then the cost per set of each on T sets of 0.5x..2x of the gyrohorizoncompass and the
 torsion gyrocompass (the operator, the probes, the enclosure of the operator used, the
-equilibrium's radius, the twin's operator with its bound as the certificate takes it: interleaved, the best of five runs each, this shared machine's load moving
-single runs by up to 2x), and of the frequencies' certificate with each (`certificate_timing`).
+equilibrium's radius, the twin's operator with its bound as the certificate takes it:
+interleaved, the best of five runs each, this shared machine's load moving single runs by
+up to 2x), and of the frequencies' certificate with each (`certificate_timing`).
 Writes bench/results/operator_rounding.json."""
 from __future__ import annotations
 

@@ -7,8 +7,10 @@ model, each parameter 0.05x..20x of the model's own values (log-uniform; bench.e
 draw), the gyrohorizoncompass also at its sets near epsilon0 = 89.99 deg: how many entries
 each beats, and the enclosure's ratio bound / actual (median, max) over the entries with an
 error. Then the cost per set of each on T sets of 0.5x..2x of the gyrohorizoncompass and the
-torsion gyrocompass (the operator, the probes, the enclosure: interleaved, the best of five runs each, this shared machine's load moving
-single runs by up to 2x), and of the frequencies' certificate with each (`certificate_timing`).
+torsion gyrocompass (the operator, the probes, the enclosure of the operator used, the
+equilibrium's radius, the twin's operator with its bound as the certificate takes it:
+interleaved, the best of five runs each, this shared machine's load moving single runs by
+up to 2x), and of the frequencies' certificate with each (`certificate_timing`).
 Writes bench/results/operator_rounding.json."""
 from __future__ import annotations
 
@@ -100,7 +102,8 @@ def timing(name: str, n: int) -> dict:
     runs = {"operator": lambda: operators(m, P, qe),
             "probes": lambda: qep.equilibrium_moves(m, P, qe, M, D, K),
             "enclosure": lambda: rounding.operator_rounding(m, P, qe, M, D, K),
-            "equilibrium_radius": lambda: rounding.equilibrium_radius(m, P, qe)}
+            "equilibrium_radius": lambda: rounding.equilibrium_radius(m, P, qe),
+            "operator_enclosed": lambda: rounding.operator_enclosed(m, P, qe)}
     best = {k: np.inf for k in runs}
     for _ in range(5):
         for k, f in runs.items():
@@ -115,8 +118,9 @@ def timing(name: str, n: int) -> dict:
 
 def certificate_timing(n: int, seed: int = 36) -> dict:
     """The frequencies' certificate's shared part per set (gyro.questions.frequencies._exact:
-    the equilibrium, the operator, its rounding, the count at 0), with the enclosure and, in
-    the same run, with the two probes in its place, beside the exact level (the default
+    the equilibrium, the operator and its rounding, the count at 0), with the enclosure
+    (rounding.operator_enclosed: the twin's operator and its bound) and, in the same run, with
+    the runtime's operator and the two probes in its place, beside the exact level (the default
     method) on the same sets: n sets of bench.levels' joint spread of the torsion
     gyrocompass, interleaved, the best of five runs each."""
     from bench.levels import joint
@@ -125,21 +129,25 @@ def certificate_timing(n: int, seed: int = 36) -> dict:
 
     m = load("torsion_gyrocompass")
     P = joint(n, seed)
-    probes = lambda model, P, qe, M, D, K: qep.equilibrium_moves(model, P, qe, M, D, K)  # noqa: E731
-    enclosure = rounding.operator_rounding
+
+    def probes(model, P, qe):  # the runtime's operator and the two probes in its place
+        M, D, K = (np.ascontiguousarray(X, dtype=float) for X in operators(model, P, qe))
+        return (M, D, K, *qep.equilibrium_moves(model, P, qe, M, D, K))
+
+    enclosure = rounding.operator_enclosed
     F._exact(m, P[:8])
     runs = {"with_enclosure": lambda: F._exact(m, P), "with_probes": lambda: F._exact(m, P),
             "exact_level": lambda: ladder.spectrum(m, P, "default")}
     best = {k: np.inf for k in runs}
     for _ in range(5):
         for k, f in runs.items():
-            rounding.operator_rounding = probes if k == "with_probes" else enclosure
+            rounding.operator_enclosed = probes if k == "with_probes" else enclosure
             try:
                 t = time.perf_counter()
                 f()
                 best[k] = min(best[k], time.perf_counter() - t)
             finally:
-                rounding.operator_rounding = enclosure
+                rounding.operator_enclosed = enclosure
     out = {f"{k}_us_per_set": v / n * 1e6 for k, v in best.items()}
     out["sets"] = n
     return out

@@ -49,8 +49,12 @@ does, but by an emitter of its own (`_simd_source`: one statement per instructio
 a vector, since CasADi's generated code keeps every value in a work array and ran 12x
 slower on the gyrohorizoncompass's operator); ISO C99 keeps -ffp-contract=off, so the
 compiled code performs the operations the bound was derived for, to the bit those of
-CasADi's own evaluation, which answers without a compiler. `operator_rounding` is what the runtime uses: the
-operator's rounding, the equilibrium's and the difference to the operator actually used.
+CasADi's own evaluation, which answers without a compiler. `operator_rounding` is the
+operator's rounding, the equilibrium's and the difference to the operator actually used;
+`operator_enclosed`, what the frequencies' certificate takes, is the twin's operator itself
+with its rounding and the equilibrium's (one evaluation: no runtime operator, no difference).
+The equilibrium's Krawczyk test does its linear algebra in C (gyro/csrc/krawczyk.c), NumPy
+without a compiler.
 """
 from __future__ import annotations
 
@@ -338,7 +342,7 @@ class Enclosure:
         if stamped is not None and stamped.exists():
             text = stamped.read_text()
         else:
-            text = _simd_source(self.G, f"{self.label}_batch")
+            text = _simd_source(self.G, f"{self.label}_batch", self.n_values)
         digest = hashlib.sha256(text.encode()).hexdigest()[:16]
         src = stamped or folder / f"{self.label}-{digest}.c"
         if not src.exists() or src.read_text() != text:
@@ -363,9 +367,9 @@ class Enclosure:
         if fn is not None:
             import ctypes
 
-            P = ctypes.POINTER(ctypes.c_double)
-            ins = (P * len(args))(*[a.ctypes.data_as(P) for a in args])
-            outs = (P * len(flat))(*[o.ctypes.data_as(P) for o in flat])
+            V = ctypes.c_void_p  # the arrays' addresses (data_as costs ~3 us each: a batch of one set)
+            ins = (V * len(args))(*[a.ctypes.data for a in args])
+            outs = (V * len(flat))(*[o.ctypes.data for o in flat])
             with np.errstate(all="ignore"):
                 if fn(ctypes.c_longlong(n), ins, outs):
                     raise ArithmeticError(f"{self.label}: the compiled enclosure failed")
@@ -375,11 +379,12 @@ class Enclosure:
             for o, r, (rows, cols) in zip(flat, res, self.shapes_out):  # (rows, sets * cols)
                 o[:] = np.asarray(r).reshape(rows, n, cols).transpose(1, 0, 2).reshape(n, rows * cols)
         values, bounds = flat[:self.n_values], flat[self.n_values:]  # row-major: _simd_source
-        with np.errstate(invalid="ignore"):
-            for j, b in enumerate(bounds):  # in place: NaN and a value not finite have no bound
-                b[~(b < np.inf)] = np.inf
-                if len(values) == len(bounds):
-                    b[~np.isfinite(values[j])] = np.inf
+        if fn is None:  # (the compiled code writes them so: _simd_source's n_values)
+            with np.errstate(invalid="ignore"):
+                for j, b in enumerate(bounds):  # in place: NaN and a value not finite have no bound
+                    b[~(b < np.inf)] = np.inf
+                    if len(values) == len(bounds):
+                        b[~np.isfinite(values[j])] = np.inf
         shape = [(n, r, c) for r, c in self.shapes_out]
         return ([x.reshape(s) for x, s in zip(values, shape)],
                 [x.reshape(s) for x, s in zip(bounds, shape[self.n_values:])])
@@ -444,8 +449,10 @@ def equilibrium_radius(model, P, qe) -> np.ndarray:
     at most d componentwise, the box holds an exact equilibrium (Brouwer) and every
     equilibrium of the box lies within |X| rho + R d of qe (Krawczyk): that is the radius.
     Rigorous (both enclosures are, the sums here inflated for their own rounding); the box
-    is 2 |X| rho first, then twice the last map's radius, KRAWCZYK_TRIES boxes at most."""
-    P, qe = np.asarray(P, dtype=float), np.asarray(qe, dtype=float)
+    is 2 |X| rho first, then twice the last map's radius, KRAWCZYK_TRIES boxes at most. The
+    linear algebra (X, |X| rho, |I - X Kn|, the map's reach) in C where a compiler is at hand
+    (gyro/csrc/krawczyk.c, the same formulas), else in NumPy (`_krawczyk_*_numpy`)."""
+    P, qe = np.ascontiguousarray(P, dtype=float), np.ascontiguousarray(qe, dtype=float)
     N, ne = qe.shape
     out = np.full((N, ne), np.inf)
     if ne == 0:
@@ -458,7 +465,40 @@ def equilibrium_radius(model, P, qe) -> np.ndarray:
     box = enclosed(model, "equilibrium_system", ("qe",), ("e_" + k_name,))
     (r, Kn), (er,) = point(P, qe)
     r, er = r[:, :, 0], er[:, :, 0]
-    live = np.all(np.isfinite(qe), axis=1) & np.all(np.isfinite(er), axis=1) & np.all(np.isfinite(Kn), axis=(1, 2))
+    kernel = _krawczyk_kernel()
+    first = _krawczyk_start_numpy if kernel is None else _krawczyk_start_c
+    live, X, base, formed, d = first(r, er, Kn)
+    live &= np.all(np.isfinite(qe), axis=1)
+    step = _krawczyk_step_numpy if kernel is None else _krawczyk_step_c
+    todo = np.flatnonzero(live)
+    for _ in range(KRAWCZYK_TRIES):
+        if todo.size == 0:
+            break
+        every = todo.size == N  # no copies of the batch where every set is tried
+        _, (eK,) = box(P, qe, d) if every else box(P[todo], qe[todo], d[todo])
+        inside = step(todo, X, formed, base, eK, d, out)
+        todo = todo[~inside & np.all(np.isfinite(d[todo]), axis=1)]
+    return out
+
+
+def _krawczyk_kernel():
+    """The compiled linear algebra of Krawczyk's test (gyro/csrc/krawczyk.c), or None (no
+    compiler, or within gyro.cbackend.disabled(): the NumPy version answers)."""
+    from gyro import cbackend
+
+    try:
+        lib = cbackend.kernel_library("krawczyk")
+    except cbackend.CompilerUnavailable:
+        return None
+    return lib
+
+
+def _krawczyk_start_numpy(r, er, Kn):
+    """(live, X, base, formed, d) of equilibrium_radius's test (its docstring), per set:
+    X a computed inverse of Kn, base >= |X| rho, formed >= |I - X Kn| with that product's
+    rounding, d = 2 base the first box; live where every input and X are finite."""
+    ne = r.shape[1]
+    live = np.all(np.isfinite(er), axis=1) & np.all(np.isfinite(r), axis=1) & np.all(np.isfinite(Kn), axis=(1, 2))
     grow = 1 + 4 * (ne + 2) * U
     X = np.full_like(Kn, np.nan)
     with np.errstate(all="ignore"):
@@ -476,19 +516,60 @@ def equilibrium_radius(model, P, qe) -> np.ndarray:
         rho = (np.abs(r) + er) * GROW
         base = np.einsum("bij,bj->bi", aX, rho) * grow + 4 * ne * TINY  # |X| rho
         formed = np.abs(np.eye(ne) - X @ Kn) + (ne + 2) * U * grow * (aX @ np.abs(Kn))
-        d = 2 * base
-        todo = np.flatnonzero(live)
-        for _ in range(KRAWCZYK_TRIES):
-            if todo.size == 0:
-                break
-            _, (eK,) = box(P[todo], qe[todo], d[todo])
-            R = (formed[todo] + aX[todo] @ eK) * grow
-            reach = (base[todo] + np.einsum("bij,bj->bi", R, d[todo])) * grow + 4 * ne * TINY
-            inside = np.all(reach <= d[todo], axis=1) & np.all(np.isfinite(reach), axis=1)
-            out[todo[inside]] = reach[inside]
-            d[todo] = 2 * np.where(np.isfinite(reach), reach, np.inf)
-            todo = todo[~inside & np.all(np.isfinite(d[todo]), axis=1)]
-    return out
+    return live, X, base, formed, 2 * base
+
+
+def _krawczyk_step_numpy(todo, X, formed, base, eK, d, out):
+    """One box of the test for the sets `todo` (eK: Kn's enclosure over their boxes |q - qe|
+    <= d): out[set] = the Krawczyk map's reach where it lies within the box; d of those sets
+    made twice the reach (the next box; +inf where not finite), in place. -> inside (todo,)."""
+    ne = X.shape[1]
+    grow = 1 + 4 * (ne + 2) * U
+    with np.errstate(all="ignore"):
+        R = (formed[todo] + np.abs(X[todo]) @ eK) * grow
+        reach = (base[todo] + np.einsum("bij,bj->bi", R, d[todo])) * grow + 4 * ne * TINY
+        inside = np.all(reach <= d[todo], axis=1) & np.all(np.isfinite(reach), axis=1)
+        out[todo[inside]] = reach[inside]
+        d[todo] = 2 * np.where(np.isfinite(reach), reach, np.inf)
+    return inside
+
+
+def _krawczyk_start_c(r, er, Kn):
+    """_krawczyk_start_numpy in C (gyro/csrc/krawczyk.c: Gauss-Jordan's X, formed never
+    smaller than the NumPy formula's for the same X)."""
+    import ctypes
+
+    N, ne = r.shape
+    if ne > 64:  # the kernel's fixed size
+        return _krawczyk_start_numpy(r, er, Kn)
+    r, er, Kn = (np.ascontiguousarray(a, dtype=float) for a in (r, er, Kn))
+    X, formed = np.empty((N, ne, ne)), np.empty((N, ne, ne))
+    base, d = np.empty((N, ne)), np.empty((N, ne))
+    live = np.empty(N, np.uint8)
+    fn = _krawczyk_kernel().gyro_krawczyk_start
+    fn.restype = None
+    with np.errstate(all="ignore"):
+        fn(ctypes.c_long(N), ctypes.c_long(ne),
+           *[ctypes.c_void_p(a.ctypes.data) for a in (r, er, Kn, X, base, formed, d, live)])
+    return live.astype(bool), X, base, formed, d
+
+
+def _krawczyk_step_c(todo, X, formed, base, eK, d, out):
+    """_krawczyk_step_numpy in C (the same formulas and order of sums)."""
+    import ctypes
+
+    ne = X.shape[1]
+    if ne > 64:
+        return _krawczyk_step_numpy(todo, X, formed, base, eK, d, out)
+    rows = np.ascontiguousarray(todo, dtype=np.int64)
+    eK = np.ascontiguousarray(eK, dtype=float)
+    inside = np.empty(rows.size, np.uint8)
+    fn = _krawczyk_kernel().gyro_krawczyk_step
+    fn.restype = None
+    with np.errstate(all="ignore"):
+        fn(ctypes.c_long(rows.size), ctypes.c_long(ne),
+           *[ctypes.c_void_p(a.ctypes.data) for a in (rows, X, formed, base, eK, d, out, inside)])
+    return inside.astype(bool)
 
 
 def operator_rounding(model, P, qe, M, D, K):
@@ -515,6 +596,24 @@ def operator_rounding(model, P, qe, M, D, K):
     return tuple(out)
 
 
+def operator_enclosed(model, P, qe):
+    """(M, D, K, dM, dD, dK): the operator at (P, qe) as its CasADi twin evaluates it in
+    double precision, and an entrywise bound of its distance from the exact operator at the
+    exact equilibrium of the double parameters P: operator_rounding of the twin's own values,
+    from one evaluation. The twin's values are an operator evaluated at qe like any other (the
+    count of gyro.questions.frequencies proves the exact operator's frequencies from whichever
+    double operator it is given and that operator's distance from the exact one), so the
+    certificate takes them and neither forms the runtime's operator nor bounds |used - twin|
+    (0 here; the bound is the enclosure's, times GROW as operator_rounding gives it)."""
+    P, qe = np.asarray(P, dtype=float), np.asarray(qe, dtype=float)
+    delta = equilibrium_radius(model, P, qe)
+    twin, bounds = enclosed(model, "operator")(P, qe, delta)
+    with np.errstate(all="ignore"):
+        for e in bounds:  # in place; a bound is +inf where its value is not finite (Enclosure)
+            e *= GROW
+    return (*twin, *bounds)
+
+
 LANES = 4  # sets per vector of the compiled enclosure (GCC's vector extension)
 
 _C_BINARY = {"OP_ADD": "{a} + {b}", "OP_SUB": "{a} - {b}", "OP_MUL": "{a} * {b}", "OP_DIV": "{a} / {b}",
@@ -533,16 +632,24 @@ _C_LIBM = {"OP_SQRT": "sqrt", "OP_SIN": "sin", "OP_COS": "cos", "OP_TAN": "tan",
            "OP_FLOOR": "floor", "OP_CEIL": "ceil", "OP_SIGN": "SIGN"}
 
 
-def _simd_source(G, entry: str) -> str:
+def _simd_source(G, entry: str, n_values: int | None = None) -> str:
     """C99 of an SX Function over a batch, LANES sets at a time in GCC's vector extension:
     one statement per instruction of G's algorithm, in its order, each the one IEEE operation
     (ISO C99: no contraction, no reassociation; libm's functions lane by lane), single
     assignment, so the compiler keeps the values in registers. `entry(n, in, out)`: in[i] is
-    input i over the sets (sets, nonzeros), out[j] likewise."""
+    input i over the sets (sets, nonzeros), out[j] likewise. The outputs of a block are kept
+    in vectors and written set by set at its end; with `n_values` (G an enclosure whose first
+    n_values outputs are values, the rest bounds), a bound is written as +inf where it is not
+    below +inf (NaN) or, where each value has its bound, where its value is not finite: what
+    `Enclosure` does to CasADi's own evaluation, here without a pass over the arrays."""
     import casadi as ca
 
     names = {getattr(ca, n): n for n in dir(ca) if n.startswith("OP_")}
     L = LANES
+    sizes = [G.size_out(j) for j in range(G.n_out())]
+    for j, (rows, cols) in enumerate(sizes):
+        if G.nnz_out(j) != rows * cols:
+            raise NotImplementedError(f"{G.name()}: a sparse output")
     head = [
         "#include <math.h>",
         f"typedef double vd __attribute__((vector_size({8 * L})));",
@@ -553,6 +660,7 @@ def _simd_source(G, entry: str) -> str:
         "_r[_i] = f(_x[_i], _y[_i]); _r; })",
         "static double SIGN(double x) { return x > 0 ? 1.0 : x < 0 ? -1.0 : x; }",
         f"int {entry}(long long n, const double* const* in, double* const* out) {{",
+        *[f"  vd o{j}[{max(r * c, 1)}];" for j, (r, c) in enumerate(sizes)],
         f"  for (long long k = 0; k < n; k += {L}) {{",
         f"    long long s[{L}];",
         f"    for (int i = 0; i < {L}; ++i) s[i] = k + i < n ? k + i : n - 1;",
@@ -566,12 +674,8 @@ def _simd_source(G, entry: str) -> str:
             lanes = ", ".join(f"in[{i[0]}][s[{q}] * {nnz} + {i[1]}]" for q in range(L))
             expr = f"(vd){{{lanes}}}"
         elif op == "OP_OUTPUT":  # a dense output's entries row by row (CasADi's nonzeros go by column)
-            rows, cols = G.size_out(o[0])
-            if G.nnz_out(o[0]) != rows * cols:
-                raise NotImplementedError(f"{G.name()}: a sparse output")
-            at = (o[1] % rows) * cols + o[1] // rows
-            body.append(f"    for (int i = 0; i < {L} && k + i < n; ++i) "
-                        f"out[{o[0]}][(k + i) * {rows * cols} + {at}] = {reg[i[0]]}[i];")
+            rows, cols = sizes[o[0]]
+            body.append(f"    o{o[0]}[{(o[1] % rows) * cols + o[1] // rows}] = {reg[i[0]]};")
             continue
         elif op == "OP_CONST":
             c = float(G.instruction_constant(k))
@@ -587,4 +691,21 @@ def _simd_source(G, entry: str) -> str:
             raise NotImplementedError(f"{G.name()}: no C for {op}")
         body.append(f"    vd a{k} = {expr};")
         reg[o[0]] = f"a{k}"
-    return "\n".join(head + body + ["  }", "  return 0;", "}", ""])
+    tail = [f"    for (int i = 0; i < {L} && k + i < n; ++i) {{"]
+    nv = G.n_out() if n_values is None else n_values
+    paired = n_values is not None and 2 * nv == G.n_out()
+    for j, (rows, cols) in enumerate(sizes):
+        size = rows * cols
+        if not size:
+            continue
+        tail.append(f"      double* d{j} = out[{j}] + (k + i) * {size};")
+        if j < nv:
+            tail.append(f"      for (int t = 0; t < {size}; ++t) d{j}[t] = o{j}[t][i];")
+        elif paired:
+            tail.append(f"      for (int t = 0; t < {size}; ++t) {{ double b = o{j}[t][i]; "
+                        f"d{j}[t] = b < INFINITY && isfinite(o{j - nv}[t][i]) ? b : INFINITY; }}")
+        else:
+            tail.append(f"      for (int t = 0; t < {size}; ++t) {{ double b = o{j}[t][i]; "
+                        f"d{j}[t] = b < INFINITY ? b : INFINITY; }}")
+    tail.append("    }")
+    return "\n".join(head + body + tail + ["  }", "  return 0;", "}", ""])

@@ -435,11 +435,11 @@ class Exact:
 
 def _exact(model, P):
     """(ok, M, D, K of the sets with an equilibrium, their operator's own rounding dM, dD, dK
-    (gyro.rounding.operator_rounding: an enclosure of the distance of M, D, K from the exact
-    operator at the exact equilibrium, the equilibrium's own error included), their counts
-    at 0) over the batch P."""
+    (gyro.rounding.operator_enclosed: the operator as the enclosure's CasADi twin evaluates
+    it and an enclosure of its distance from the exact operator at the exact equilibrium, the
+    equilibrium's own error included), their counts at 0) over the batch P."""
     from gyro import rounding
-    from gyro.equilibrium import equilibria, operators
+    from gyro.equilibrium import equilibria
 
     qe, ok = equilibria(model, P)
     n = len(model.meta["reduced"])
@@ -448,9 +448,8 @@ def _exact(model, P):
         return ok, empty, empty, empty, empty, empty, empty, np.zeros(0, int)
     every = bool(ok.all())  # no copies of the batch where every set has its equilibrium
     Pk, qk = (P, qe) if every else (P[ok], qe[ok])
-    M, D, K = operators(model, Pk, qk)
-    M, D, K = (np.ascontiguousarray(X, dtype=float) for X in (M, D, K))
-    moves = rounding.operator_rounding(model, Pk, qk, M, D, K)
+    # the operator as the enclosure's twin evaluates it, with its distance from the exact one
+    M, D, K, *moves = rounding.operator_enclosed(model, Pk, qk)
     zero = counts_at(M, D, K, np.zeros((M.shape[0], 1)), moves=moves)[:, 0]
     return (ok, M, D, K, *moves, zero)
 

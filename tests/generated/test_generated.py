@@ -379,7 +379,8 @@ def test_c_printer_parenthesises_powers_in_denominators():
 
 def _builds():
     """What the runtime compiles: every model's C, the kernels of each operator dimension
-    the models have (gyro.cbackend.KERNELS, -DQEP_N=n) and the polynomial roots."""
+    the models have (gyro.cbackend.KERNELS, -DQEP_N=n), the polynomial roots and the
+    equilibrium's Krawczyk test."""
     from gyro import cbackend, questions
 
     dims = sorted({next(o["shape"][0] for o in m["functions"]["operator"]["outputs"] if o["name"] == "M") for m in
@@ -389,6 +390,7 @@ def _builds():
             + [pytest.param([cbackend.CSRC / f for f in cbackend.KERNELS["qep"]], (f"-DQEP_N={n}",), id=f"qep-n{n}")
                for n in dims]
             + [pytest.param([cbackend.CSRC / f for f in cbackend.KERNELS["polyroots"]], (), id="polyroots")]
+            + [pytest.param([cbackend.CSRC / f for f in cbackend.KERNELS["krawczyk"]], (), id="krawczyk")]
             # the frequencies' certificate's count (a build that failed once fell back to NumPy unseen)
             + [pytest.param([Path(questions.__file__).parent / "inertia.c"], (), id="inertia")])
 

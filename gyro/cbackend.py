@@ -128,7 +128,7 @@ def _library(directory: str, model_name: str) -> ctypes.CDLL:
 CSRC = Path(__file__).resolve().parent / "csrc"
 # the kernels' libraries: their sources in gyro/csrc/ (every header there is part of each)
 KERNELS = {"qep": ("qep.c", "qep_starts.c", "sensitivity.c"), "polyroots": ("polyroots.c",),
-           "krawczyk": ("krawczyk.c",)}
+           "krawczyk": ("krawczyk.c",), "intervals": ("intervals.c",)}
 
 
 def kernel_library(kind: str, n: int | None = None) -> ctypes.CDLL:

@@ -254,6 +254,7 @@ class Program:
             op = fun.instruction_id(k)
             self.code.append((op, fun.instruction_output(k), fun.instruction_input(k), fun.instruction_constant(k)))
         self.INPUT, self.OUTPUT, self.CONST = ca.OP_INPUT, ca.OP_OUTPUT, ca.OP_CONST
+        self.bytecode = None  # the compiled walker's arrays (`_bytecode`), built on first use
 
     def run(self, inputs, ops, const, entire):
         """The walk: `inputs` per Function input a sequence of its nonzeros' values (any
@@ -280,6 +281,88 @@ class Program:
         return outs
 
 
+# The compiled walker (gyro/csrc/intervals.c): its operation codes, in the order of its enum.
+C_OPS = ("INPUT", "OUTPUT", "CONST", "ADD", "SUB", "MUL", "DIV", "NEG", "TWICE", "INV", "SQ", "SQRT", "FABS",
+         "SIN", "COS", "TAN", "EXP", "LOG", "POWI", "POW", "ATAN", "TANH", "SINH", "ASINH", "COSH", "FMIN",
+         "FMAX", "ERF", "ENTIRE")
+_C_CODE = {name: k for k, name in enumerate(C_OPS)}
+
+
+def _bytecode(prog: Program):
+    """The Program as the arrays of gyro/csrc/intervals.c (op, out, in0, in1, constant): the
+    CasADi operation by name (OP_CONSTPOW and OP_POW by a constant integer exponent below 64
+    in magnitude, known from the register's last OP_CONST, as `_pow` decides: IV_POWI with n in
+    in1; else exp(b log a)); an operation without a C extension: IV_ENTIRE on each output."""
+    import casadi as ca
+
+    names = {getattr(ca, n): n[3:] for n in dir(ca) if n.startswith("OP_")}
+    rows, const = [], {}
+    for op, o, i, c in prog.code:
+        name = names.get(op, "")
+        if op == prog.INPUT:
+            rows.append((_C_CODE["INPUT"], o[0], i[0], i[1], 0.0))
+        elif op == prog.OUTPUT:
+            rows.append((_C_CODE["OUTPUT"], o[0], i[0], int(prog.where_out[o[0]][o[1]]), 0.0))
+        elif op == prog.CONST:
+            rows.append((_C_CODE["CONST"], o[0], 0, 0, float(c)))
+        elif name in ("POW", "CONSTPOW"):
+            e = const.get(i[1])
+            if e is not None and float(e).is_integer() and abs(e) < 64:
+                rows.append((_C_CODE["POWI"], o[0], i[0], int(e), 0.0))
+            else:
+                rows.append((_C_CODE["POW"], o[0], i[0], i[1], 0.0))
+        elif name in _C_CODE and name not in ("INPUT", "OUTPUT", "CONST", "POWI", "ENTIRE") and op in _OPS:
+            rows.append((_C_CODE[name], o[0], i[0], i[1] if len(i) > 1 else i[0], 0.0))
+        else:
+            rows.extend((_C_CODE["ENTIRE"], j, 0, 0, 0.0) for j in o)
+        for j in o if op != prog.OUTPUT else ():  # a register's constant while it holds one
+            const.pop(j, None)
+        if op == prog.CONST:
+            const[o[0]] = float(c)
+    ints = np.array([r[:4] for r in rows], dtype=np.intc).reshape(-1, 4)
+    return (np.ascontiguousarray(ints[:, 0]), np.ascontiguousarray(ints[:, 1]), np.ascontiguousarray(ints[:, 2]),
+            np.ascontiguousarray(ints[:, 3]), np.array([r[4] for r in rows], float))
+
+
+def _kernel():
+    """The compiled walker's entry point, or None (no compiler, or within
+    gyro.cbackend.disabled(): the NumPy walker answers)."""
+    from gyro import cbackend
+
+    try:
+        lib = cbackend.kernel_library("intervals")
+    except cbackend.CompilerUnavailable:
+        return None
+    fn = lib.gyro_intervals_run
+    fn.restype = None
+    return fn
+
+
+def _run_c(fn, prog: Program, ins, width: int):
+    """The Program over `width` boxes by the compiled walker: `ins` per input (lo, hi) arrays
+    (nnz, width); per output (lo, hi) (numel, width) as `evaluate`'s."""
+    import ctypes
+
+    if prog.bytecode is None:
+        prog.bytecode = _bytecode(prog)
+    op, out, in0, in1, cst = prog.bytecode
+    lo_in = [np.ascontiguousarray(np.broadcast_to(np.asarray(lo, float).reshape(n, -1), (n, width)))
+             for (lo, _), n in zip(ins, prog.n_in)]
+    hi_in = [np.ascontiguousarray(np.broadcast_to(np.asarray(hi, float).reshape(n, -1), (n, width)))
+             for (_, hi), n in zip(ins, prog.n_in)]
+    outs = [(np.zeros((numel, width)), np.zeros((numel, width))) for numel in prog.numel_out]
+    w = np.empty((2, max(prog.size_w, 1) * C_CHUNK))
+    V = ctypes.c_void_p
+    arr = lambda xs: (V * max(len(xs), 1))(*[x.ctypes.data for x in xs])  # noqa: E731
+    fn(ctypes.c_long(width), ctypes.c_long(len(op)), *[V(a.ctypes.data) for a in (op, out, in0, in1, cst)],
+       ctypes.c_long(prog.size_w), ctypes.c_int(TRANSCENDENTAL_ULPS), arr(lo_in), arr(hi_in),
+       arr([o[0] for o in outs]), arr([o[1] for o in outs]), V(w[0].ctypes.data), V(w[1].ctypes.data))
+    return outs
+
+
+C_CHUNK = 64  # gyro/csrc/intervals.c's CH: the boxes one pass of the instructions takes
+
+
 def program(fun) -> Program:
     """The Program of an SX Function, built once per Function object."""
     key = id(fun)
@@ -288,16 +371,18 @@ def program(fun) -> Program:
     return _PROGRAMS[key]
 
 
-def evaluate(fun, inputs):
+def evaluate(fun, inputs, compiled: bool = True):
     """Interval values of `fun` over boxes: `inputs` per Function input a pair (lo, hi) of
     arrays (nnz,) or (nnz, N) (N boxes; a point is lo = hi). Returns per output a pair (lo,
     hi) of arrays (numel, N) (or (numel,) where no input has N; the output dense,
     column-major, its structural zeros 0): for every point of the boxes,
-    the Function's exact value lies in [lo, hi]; [-inf, inf] where it is not enclosed."""
+    the Function's exact value lies in [lo, hi]; [-inf, inf] where it is not enclosed.
+    By the compiled walker (gyro/csrc/intervals.c, the same operations in C) where there is a
+    compiler and `compiled`; else by NumPy."""
     prog = program(fun)
     width = max((np.shape(x)[1] for b in inputs for x in b if np.ndim(x) == 2), default=0)
     if width > CHUNK:  # the work vector's registers for all boxes at once would not fit: in pieces
-        parts = [evaluate(fun, [tuple(x[:, k:k + CHUNK] if np.ndim(x) == 2 else x for x in b) for b in inputs])
+        parts = [evaluate(fun, [tuple(x[:, k:k + CHUNK] if np.ndim(x) == 2 else x for x in b) for b in inputs], compiled)
                  for k in range(0, width, CHUNK)]
         return [(np.concatenate([p[i][0] for p in parts], axis=1), np.concatenate([p[i][1] for p in parts], axis=1))
                 for i in range(len(parts[0]))]
@@ -310,6 +395,10 @@ def evaluate(fun, inputs):
             raise ValueError(f"an input box of {fun.name()} is empty or NaN (lo > hi)")
         ins.append([(lo[k], hi[k]) for k in range(n)])
     shape = np.broadcast(*[np.asarray(x)[0] for b in inputs for x in b if np.size(x)]).shape
+    fn = _kernel() if compiled else None
+    if fn is not None:
+        outs = _run_c(fn, prog, inputs, shape[0] if shape else 1)
+        return outs if shape else [(lo[:, 0], hi[:, 0]) for lo, hi in outs]
     with np.errstate(over="ignore", invalid="ignore"):
         outs = prog.run(ins, _OPS, lambda c: (c, c), _entire)
     result = []

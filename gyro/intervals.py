@@ -443,6 +443,43 @@ def centred(fun, jac, which: int, inputs, natural: bool = True):
     return out
 
 
+def taylor2(fun, jac, hess, which: int, inputs):
+    """The second-order Taylor form over the boxes: f(X) in f(c) + J(c) (X - c) + (X - c)^T
+    H(X) (X - c) / 2 (Taylor's theorem with the Lagrange remainder, H at a point of the segment
+    from c, inside the box), c the boxes' centres in input `which`; f(c) and J(c) enclosed at
+    the point c (narrow: no excess of the box's width), H(X) the interval Hessian (`hess`:
+    `jacobian_function(jac, which)`, per output (nnz_out * nnz_which, nnz_which) nonzeros
+    column-major). Where J itself is a difference of near-equal terms (the Jacobian of a
+    residual), J(X) of the centred form is wide by those terms times the width, and this
+    form's excess is of the square of the width times the second derivatives only. Returns
+    per output a pair (lo, hi) as `evaluate`."""
+    lo, hi = (np.asarray(x, float) for x in inputs[which])
+    c = np.minimum(np.maximum(lo + (hi - lo) / 2, lo), hi)
+    at_c = [x if k != which else (c, c) for k, x in enumerate(inputs)]
+    F, J, H = evaluate(fun, at_c), evaluate(jac, at_c), evaluate(hess, inputs)
+    d = (np.minimum(down(lo - c), 0.0), np.maximum(up(hi - c), 0.0))
+    n = lo.shape[0]
+    out = []
+    for (flo, fhi), (jlo, jhi), (hlo, hhi) in zip(F, J, H):
+        m = flo.shape[0]
+        jl = jlo.reshape(n, m, *jlo.shape[1:]).swapaxes(0, 1)
+        jh = jhi.reshape(n, m, *jhi.shape[1:]).swapaxes(0, 1)
+        hl = hlo.reshape(n, n, m, *hlo.shape[1:])  # (l, k, i): d2 f_i / dx_k dx_l, column-major nonzeros
+        hh = hhi.reshape(n, n, m, *hhi.shape[1:])
+        slo, shi = flo, fhi
+        for k in range(n):
+            slo, shi = _add((slo, shi), _mul((jl[:, k], jh[:, k]), (d[0][k], d[1][k])))
+        q = None
+        for k in range(n):
+            for l in range(n):
+                dd = _sq((d[0][k], d[1][k])) if k == l else _mul((d[0][k], d[1][k]), (d[0][l], d[1][l]))
+                t = _mul((hl[l, k], hh[l, k]), dd)
+                q = t if q is None else _add(q, t)
+        slo, shi = _add((slo, shi), _mul(q, (0.5, 0.5)))  # (rounded outward: a subnormal's half is not exact)
+        out.append((slo, shi))
+    return out
+
+
 def jacobian_function(fun, which: int):
     """The Function of the same inputs giving, for each output, its dense Jacobian in input
     `which` (the `centred` form's J)."""

@@ -814,13 +814,17 @@ def _unpack(col: np.ndarray) -> dict:
     return out
 
 
-CANCELLING = ("rho1", "eta", "sigma")  # small differences of large terms: the centred form's
+CANCELLING = (("rho1", "eta", "sigma"), ("Q",))  # small differences of large terms: the centred form's
+# (each group one Function: the centred form of one piece depends on the algorithm CasADi
+# builds for its group's Jacobian, and Q in the first group widens eta and sigma's)
 
 
-@lru_cache(maxsize=1)
-def _cancelling_function():
-    """The tube function's pieces CANCELLING (rho1: second order; eta and sigma: the first-order
-    defect, a residual of the full equations), as a Function of (p, s), and its Jacobian in s."""
+@lru_cache(maxsize=2)
+def _cancelling_function(group: tuple = CANCELLING[0]):
+    """The tube function's pieces `group` (rho1: second order; eta and sigma: the first-order
+    defect, a residual of the full equations; Q: the energy rate's quadratic form, its terms
+    of Mr's change along the motion and the Coriolis moments, which cancel in part), as a
+    Function of (p, s), and its Jacobian in s."""
     import casadi as ca
 
     f = _tube_function()
@@ -829,29 +833,48 @@ def _cancelling_function():
     k, pick = 0, []
     for name, shape in _SHAPES.items():
         size = int(np.prod(shape))
-        if name in CANCELLING:
+        if name in group:
             pick.append(col[k:k + size])
         k += size
-    fun = ca.Function("precession_cancelling", [p, s], [ca.vertcat(*pick)], {"cse": True})
+    fun = ca.Function("precession_cancelling_" + "_".join(group), [p, s], [ca.vertcat(*pick)], {"cse": True})
     return fun, intervals.jacobian_function(fun, 1)
+
+
+@lru_cache(maxsize=1)
+def _cancelling_hessian():
+    """The Hessian in s of the first CANCELLING group (its Jacobian's Jacobian)."""
+    return intervals.jacobian_function(_cancelling_function(CANCELLING[0])[1], 1)
+
+
+def _intersect(L: dict, H: dict, group: tuple, flo, fhi) -> None:
+    """The pieces `group` of (L, H) intersected with another enclosure (flo, fhi) of them,
+    stacked as the group's Function stacks them (in the tube function's order)."""
+    k = 0
+    for name, shape in _SHAPES.items():
+        if name in group:
+            size = int(np.prod(shape))
+            L[name] = np.maximum(L[name], flo[k:k + size].T.reshape(L[name].shape))
+            H[name] = np.minimum(H[name], fhi[k:k + size].T.reshape(H[name].shape))
+            k += size
 
 
 def _tube_intervals(values: dict, lo, hi) -> dict:
     """Each piece of the tube function as an interval (lo, hi) over the boxes [lo, hi]
     (n, 3): for every state in a box, its value is inside (gyro.intervals): the natural
     interval extension, and for the pieces CANCELLING the centred form (f(c) + J(X) (X - c)),
-    whose excess is of the square of the box's width where the natural one's is of the width."""
+    whose excess is of the square of the box's width where the natural one's is of the width;
+    for rho1, eta and sigma also the second-order Taylor form (f(c) + J(c) (X - c) + (X -
+    c)^T H(X) (X - c) / 2: their Jacobians cancel too, and J(X) carries the cancelling terms
+    times the width); each the intersection of its enclosures."""
     P = vector(values)
     (clo, chi), = intervals.evaluate(_tube_function(), [(P, P), (lo.T, hi.T)])
     L, H = _unpack(clo.T), _unpack(chi.T)
-    fun, jac = _cancelling_function()
-    (flo, fhi), = intervals.centred(fun, jac, 1, [(P, P), (lo.T, hi.T)], natural=False)
-    k = 0
-    for name in CANCELLING:
-        size = int(np.prod(_SHAPES[name]))
-        L[name] = np.maximum(L[name], flo[k:k + size].T.reshape(L[name].shape))
-        H[name] = np.minimum(H[name], fhi[k:k + size].T.reshape(H[name].shape))
-        k += size
+    box = [(P, P), (lo.T, hi.T)]
+    for group in CANCELLING:
+        fun, jac = _cancelling_function(group)
+        _intersect(L, H, group, *intervals.centred(fun, jac, 1, box, natural=False)[0])
+    fun, jac = _cancelling_function(CANCELLING[0])  # the residuals: also their second-order Taylor form
+    _intersect(L, H, CANCELLING[0], *intervals.taylor2(fun, jac, _cancelling_hessian(), 1, box)[0])
     return {k: (L[k], H[k]) for k in L}
 
 

@@ -847,29 +847,34 @@ def _cancelling_hessian():
 
 
 def _intersect(L: dict, H: dict, group: tuple, flo, fhi) -> None:
-    """The pieces `group` of (L, H) intersected with another enclosure (flo, fhi) of them,
-    stacked as the group's Function stacks them (in the tube function's order)."""
-    k = 0
+    """The pieces `group` of (L, H) intersected with another enclosure (flo, fhi) of them over
+    the first boxes (as many as flo has), stacked as the group's Function stacks them (in the
+    tube function's order)."""
+    k, m = 0, flo.shape[1]
     for name, shape in _SHAPES.items():
         if name in group:
             size = int(np.prod(shape))
-            L[name] = np.maximum(L[name], flo[k:k + size].T.reshape(L[name].shape))
-            H[name] = np.minimum(H[name], fhi[k:k + size].T.reshape(H[name].shape))
+            L[name][:m] = np.maximum(L[name][:m], flo[k:k + size].T.reshape((m, *shape)))
+            H[name][:m] = np.minimum(H[name][:m], fhi[k:k + size].T.reshape((m, *shape)))
             k += size
 
 
-def _tube_intervals(values: dict, lo, hi) -> dict:
+def _tube_intervals(values: dict, lo, hi, rows: int | None = None) -> dict:
     """Each piece of the tube function as an interval (lo, hi) over the boxes [lo, hi]
     (n, 3): for every state in a box, its value is inside (gyro.intervals): the natural
     interval extension, and for the pieces CANCELLING the centred form (f(c) + J(X) (X - c)),
     whose excess is of the square of the box's width where the natural one's is of the width;
     for rho1, eta and sigma also the second-order Taylor form (f(c) + J(c) (X - c) + (X -
     c)^T H(X) (X - c) / 2: their Jacobians cancel too, and J(X) carries the cancelling terms
-    times the width); each the intersection of its enclosures."""
+    times the width); each the intersection of its enclosures. `rows`: those forms over the
+    first `rows` boxes only (the others' cancelling pieces are not needed)."""
     P = vector(values)
     (clo, chi), = intervals.evaluate(_tube_function(), [(P, P), (lo.T, hi.T)])
     L, H = _unpack(clo.T), _unpack(chi.T)
-    box = [(P, P), (lo.T, hi.T)]
+    rows = len(lo) if rows is None else rows
+    if not rows:
+        return {k: (L[k], H[k]) for k in L}
+    box = [(P, P), (lo[:rows].T, hi[:rows].T)]
     for group in CANCELLING:
         fun, jac = _cancelling_function(group)
         _intersect(L, H, group, *intervals.centred(fun, jac, 1, box, natural=False)[0])
@@ -922,7 +927,10 @@ def _enclosed_constants_of(values: dict, box, rates_, dl, r: float, start) -> di
     inv_h = (iv.down(1 / H0) * ones, iv.up(1 / H0) * ones)
     G = (np.stack([cb[0], ones, inv_h[0]], -1), np.stack([cb[1], ones, inv_h[1]], -1))
     reach = np.stack([iv.up(r / cb[0]), np.full(n, r), np.full(n, iv.up(r * H0))], -1)
-    both = _tube_intervals(values, np.vstack([iv.down(lo - reach), lo, start]), np.vstack([iv.up(hi + reach), hi, start]))
+    # the cancelling pieces' centred and Taylor forms over the tube only: of the level's box
+    # only D pi is used (kappa), of the start (a point) eta and Mr
+    both = _tube_intervals(values, np.vstack([iv.down(lo - reach), lo, start]), np.vstack([iv.up(hi + reach), hi, start]),
+                           rows=n)
     tube = {k: (x[0][:n], x[1][:n]) for k, x in both.items()}
     own = {k: (x[0][n:2 * n], x[1][n:2 * n]) for k, x in both.items()}
     at0 = {k: (x[0][2 * n:], x[1][2 * n:]) for k, x in both.items()}

@@ -338,6 +338,13 @@ def _kernel():
     return fn
 
 
+def compiled() -> bool:
+    """Whether `evaluate` runs the compiled walker here (a compiler, and not within
+    gyro.cbackend.disabled()): callers choose their forms by the cost (tighter forms with more
+    instructions where each costs about a nanosecond per box, not a dozen NumPy calls)."""
+    return _kernel() is not None
+
+
 def _run_c(fn, prog: Program, ins, width: int):
     """The Program over `width` boxes by the compiled walker: `ins` per input (lo, hi) arrays
     (nnz, width); per output (lo, hi) (numel, width) as `evaluate`'s."""

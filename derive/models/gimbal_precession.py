@@ -350,12 +350,13 @@ def quantities():
 
 # seconds per set for a 10 s horizon, 201 points, with the bound (bench/precession.py
 # --costs, bench/results/precession.json "costs": the median CPU time of the evaluator). The
-# four precession levels measured 22-26 ms (the enclosure's constants over the steps and the
-# tube in interval arithmetic by the compiled walker, gyro/csrc/intervals.c; 142-195 ms by the
-# NumPy walker, without a compiler): each is declared at their common median, so that the
-# declared order, simplest first, breaks the tie; full measured 0.41-0.46 s (the answer and the
-# bound's two runs).
-PRECESSION_COST = 0.025
+# four precession levels measured 32-35 ms (the enclosure's constants over the steps and the
+# tube in interval arithmetic by the compiled walker, gyro/csrc/intervals.c, with the
+# residuals' second-order Taylor form, 22-25 ms without it; 142-195 ms by the NumPy walker with
+# the first-order forms, without a compiler): each is declared at their common median, so that
+# the declared order, simplest first, breaks the tie; full measured 0.41-0.46 s (the answer and
+# the bound's two runs).
+PRECESSION_COST = 0.034
 COSTS = {"elementary": PRECESSION_COST, "small": PRECESSION_COST, "rigorous": PRECESSION_COST,
          "image": PRECESSION_COST, "full": 0.412}
 NEGLECTS = {

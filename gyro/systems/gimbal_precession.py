@@ -867,7 +867,10 @@ def _tube_intervals(values: dict, lo, hi, rows: int | None = None) -> dict:
     for rho1, eta and sigma also the second-order Taylor form (f(c) + J(c) (X - c) + (X -
     c)^T H(X) (X - c) / 2: their Jacobians cancel too, and J(X) carries the cancelling terms
     times the width); each the intersection of its enclosures. `rows`: those forms over the
-    first `rows` boxes only (the others' cancelling pieces are not needed)."""
+    first `rows` boxes only (the others' cancelling pieces are not needed). The Taylor form
+    and Q's centred form only with the compiled walker (gyro.intervals.compiled): in NumPy
+    they cost 0.4 s a bound, more than `full`; without them the bound is the first-order
+    forms' (an enclosure too, refused more often)."""
     P = vector(values)
     (clo, chi), = intervals.evaluate(_tube_function(), [(P, P), (lo.T, hi.T)])
     L, H = _unpack(clo.T), _unpack(chi.T)
@@ -875,11 +878,13 @@ def _tube_intervals(values: dict, lo, hi, rows: int | None = None) -> dict:
     if not rows:
         return {k: (L[k], H[k]) for k in L}
     box = [(P, P), (lo[:rows].T, hi[:rows].T)]
-    for group in CANCELLING:
+    tight = intervals.compiled()  # in NumPy the Taylor form and Q's centred form would cost more than `full`
+    for group in CANCELLING if tight else CANCELLING[:1]:
         fun, jac = _cancelling_function(group)
         _intersect(L, H, group, *intervals.centred(fun, jac, 1, box, natural=False)[0])
-    fun, jac = _cancelling_function(CANCELLING[0])  # the residuals: also their second-order Taylor form
-    _intersect(L, H, CANCELLING[0], *intervals.taylor2(fun, jac, _cancelling_hessian(), 1, box)[0])
+    if tight:  # the residuals: also their second-order Taylor form
+        fun, jac = _cancelling_function(CANCELLING[0])
+        _intersect(L, H, CANCELLING[0], *intervals.taylor2(fun, jac, _cancelling_hessian(), 1, box)[0])
     return {k: (L[k], H[k]) for k in L}
 
 

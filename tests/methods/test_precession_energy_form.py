@@ -5,11 +5,13 @@ the natural extension's (measured: a 70th at the median, a 10.6th at the worst o
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from gyro import intervals
 from gyro.systems import gimbal_precession as pr
 
 
+@pytest.mark.skipif(not intervals.compiled(), reason="no C compiler: the first-order forms only")
 def test_the_energy_form_is_enclosed_by_the_centred_form_over_a_tube_box():
     v = pr.parameters({"u_zeta": 1.0, "C1": 1e-3, "C2": 3e-3})
     rng = np.random.default_rng(7)

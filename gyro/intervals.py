@@ -1,4 +1,6 @@
-"""Interval evaluation of a CasADi SX Function over boxes, vectorised in NumPy.
+"""Interval evaluation of a CasADi SX Function over boxes: compiled (gyro/csrc/intervals.c,
+the same operations with the same roundings, one interpreter for every Function) where
+there is a compiler, vectorised in NumPy otherwise.
 
 `evaluate(fun, inputs)` walks the Function's algorithm (`Function.instructions`: each
 instruction's operation, its work-vector inputs and output, its constant) once, with every

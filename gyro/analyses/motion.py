@@ -287,9 +287,12 @@ def simulate(model, values: dict, offsets: dict, t: np.ndarray, method: str = "D
                              f"{BUDGET_EVALUATIONS:.0e}: a shorter horizon")
     t0 = time.perf_counter()
     cons = st.constraints
-    Y = ode.integrate_state(model, P, st.y0, t, method, RTOL, ATOL, budget_s, BUDGET_EVALUATIONS,
-                            inputs=_inputs(model), label=f"{method} on {model.name}",
-                            project=cons.project if cons else None)
+    try:
+        Y = ode.integrate_state(model, P, st.y0, t, method, RTOL, ATOL, budget_s, BUDGET_EVALUATIONS,
+                                inputs=_inputs(model), label=f"{method} on {model.name}",
+                                project=cons.project if cons else None)
+    except ode.IntegrationBudget as exc:
+        raise ode.IntegrationBudget(f"{exc}{_switching(model)}") from None
     if not np.all(np.isfinite(Y)):
         raise FloatingPointError("a coordinate is not finite along the motion")
     n = len(model.meta["coordinates"])
@@ -300,6 +303,21 @@ def simulate(model, values: dict, offsets: dict, t: np.ndarray, method: str = "D
                  "constraint_residual": dict(zip(names, map(float, cons.drift)))}
     return coordinate_motion(model, method, t, Y[:, :n], Y[:, n:], dict(values), dict(offsets), st.equilibrium,
                              time.perf_counter() - t0, extra)
+
+
+def _switching(model) -> str:
+    """For a budget exhausted on a model with non-smooth terms (metadata 'nondifferentiable',
+    derive/nonsmooth.py): the likely reason, named. A term such as sign(x_d) of a Coulomb
+    force whose argument stays at its kink (a block that sticks: the spring's pull below the
+    friction's bound) switches at every step, and the integrator's steps shrink without end
+    (a block from rest plus 0.01 m: 5e6 evaluations for 1.7e-6 s); the smooth equations
+    have no motion to give there, so what it would take is said, not a guess made."""
+    terms = [d["term"] for d in model.meta.get("nondifferentiable", ()) if d["term"].startswith("sign(")]
+    if not terms:
+        return ""
+    return (f"; the equations hold {', '.join(terms)}: where its argument stays at 0 (sticking under Coulomb "
+            "friction) the force switches at every step and no integrator of these equations gets past; "
+            "start where it slides, or write a smooth law (tanh(x_d/eps))")
 
 
 # the generic motion's document: these keys, then each coordinate not among them

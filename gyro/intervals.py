@@ -236,6 +236,14 @@ CHUNK = 8192  # boxes evaluated at once (each register holds two arrays of this 
 _PROGRAMS: dict = {}
 
 
+def instructions(fun) -> list:
+    """A CasADi SX Function's algorithm in its evaluation order: (op, output registers, input
+    registers, constant) per instruction. Read once here for every walker of it: this
+    module's interval arithmetic and gyro.rounding's running error bound."""
+    return [(fun.instruction_id(k), fun.instruction_output(k), fun.instruction_input(k), fun.instruction_constant(k))
+            for k in range(fun.n_instructions())]
+
+
 class Program:
     """The instruction list of a CasADi SX Function: (op, output register, input registers,
     constant) per instruction, and the Function's input and output shapes (nonzeros)."""
@@ -251,10 +259,7 @@ class Program:
         self.numel_out = [fun.numel_out(i) for i in range(fun.n_out())]
         self.where_out = [np.asarray(fun.sparsity_out(i).find(), int) for i in range(fun.n_out())]  # column-major
         self.size_w = fun.sz_w()
-        self.code = []
-        for k in range(fun.n_instructions()):
-            op = fun.instruction_id(k)
-            self.code.append((op, fun.instruction_output(k), fun.instruction_input(k), fun.instruction_constant(k)))
+        self.code = instructions(fun)
         self.INPUT, self.OUTPUT, self.CONST = ca.OP_INPUT, ca.OP_OUTPUT, ca.OP_CONST
         self.bytecode = None  # the compiled walker's arrays (`_bytecode`), built on first use
 

@@ -91,6 +91,8 @@ def enclosure(F, uncertain=None, name: str | None = None, keep=None):
     pruned to what they need."""
     import casadi as ca
 
+    from gyro.intervals import instructions
+
     names = [F.name_in(i) for i in range(F.n_in())]
     uncertain = names if uncertain is None else list(uncertain)
     for nm in uncertain:
@@ -124,10 +126,7 @@ def enclosure(F, uncertain=None, name: str | None = None, keep=None):
         return LIBM * av + LIBM_ULPS * TINY
 
     v, e, const, absv = {}, {}, {}, {}
-    for k in range(F.n_instructions()):
-        op = F.instruction_id(k)
-        i = F.instruction_input(k)
-        o = F.instruction_output(k)
+    for op, o, i, c in instructions(F):
         if op == ca.OP_INPUT:
             nm = names[i[0]]
             v[o[0]] = x_nz[i[0]][i[1]]
@@ -140,7 +139,7 @@ def enclosure(F, uncertain=None, name: str | None = None, keep=None):
             out_v[o[0]][o[1]], out_e[o[0]][o[1]] = v[i[0]], (ex if ex.is_zero() else hi(ex) + FLOOR)
             continue
         if op == ca.OP_CONST:
-            c = float(F.instruction_constant(k))
+            c = float(c)
             v[o[0]] = ca.SX(c)
             e[o[0]] = zero if _short_dyadic(c) else ca.SX(4 * U * abs(c))
             const[o[0]] = c
